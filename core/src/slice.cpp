@@ -1,0 +1,295 @@
+// Plane ∩ mesh by topology: every facet crossing the plane gives one segment from the mesh edge
+// where its winding goes down through the plane to the edge where it comes back up; segments are
+// chained through those edges, so no distance tolerance is ever needed. A vertex exactly on the
+// plane counts as above it (one consistent rule, "simulation of simplicity"): a facet crosses iff
+// it has a vertex strictly below and one on or above, horizontal facets never cross, and the
+// points on an edge ending at an on-plane vertex are that vertex, bit for bit.
+#include "lamina/core/slice.hpp"
+
+#include "slice_internal.hpp"
+
+#include <fmt/format.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+namespace lamina {
+namespace {
+
+struct Segment {
+  std::int32_t start_edge;  // the facet's winding goes from above to below the plane here
+  std::int32_t end_edge;    // ... and from below to above here
+  std::int32_t face;
+};
+
+// Per-thread tables indexed by mesh edge; reset after each slice by touching only used entries.
+struct Scratch {
+  std::vector<std::int32_t> start_head;  // first segment starting at an edge, -1 if none
+  std::vector<std::int32_t> ends_at;     // number of segments ending at an edge
+  std::vector<std::int32_t> next_same_start;
+  std::vector<Segment> segments;
+  std::vector<char> used;
+};
+
+// The crossing point of the plane with mesh edge e, computed from the edge's canonical vertex
+// order so that both facets sharing the edge get identical coordinates.
+Eigen::Vector2d edge_point(const Mesh& mesh, std::int32_t e, double z) {
+  const Edge& edge = mesh.edges[static_cast<std::size_t>(e)];
+  const Eigen::Vector3d& p0 = mesh.vertices[static_cast<std::size_t>(edge.v0)];
+  const Eigen::Vector3d& p1 = mesh.vertices[static_cast<std::size_t>(edge.v1)];
+  // The vertex on or above the plane may lie exactly on it: then the point is that vertex.
+  if (p0.z() == z) return p0.head<2>();
+  if (p1.z() == z) return p1.head<2>();
+  const double t = (z - p0.z()) / (p1.z() - p0.z());
+  return p0.head<2>() + t * (p1.head<2>() - p0.head<2>());
+}
+
+void collect_segments(const Mesh& mesh, std::span<const std::int32_t> faces, double z,
+                      std::vector<Segment>& out) {
+  out.clear();
+  for (const std::int32_t f : faces) {
+    const auto& tri = mesh.faces[static_cast<std::size_t>(f)];
+    const auto& fe = mesh.face_edges[static_cast<std::size_t>(f)];
+    bool above[3];
+    for (int k = 0; k < 3; ++k) above[k] = mesh.vertices[static_cast<std::size_t>(tri[k])].z() >= z;
+    std::int32_t start = -1, end = -1;
+    for (int k = 0; k < 3; ++k) {
+      const bool a = above[k], b = above[(k + 1) % 3];
+      if (a && !b) start = fe[k];
+      if (!a && b) end = fe[k];
+    }
+    if (start >= 0 && end >= 0) out.push_back({start, end, f});
+  }
+}
+
+// Pick the unused segment that continues at `edge`; on a non-manifold edge several may start
+// there: prefer one of the same shell, so touching bodies stay separate loops.
+std::int32_t next_segment(const Mesh& mesh, const Scratch& s, std::int32_t edge, std::int32_t shell) {
+  std::int32_t fallback = -1;
+  for (std::int32_t c = s.start_head[static_cast<std::size_t>(edge)]; c >= 0;
+       c = s.next_same_start[static_cast<std::size_t>(c)]) {
+    if (s.used[static_cast<std::size_t>(c)]) continue;
+    const auto face = static_cast<std::size_t>(s.segments[static_cast<std::size_t>(c)].face);
+    if (mesh.shell_id[face] == shell) return c;
+    if (fallback < 0) fallback = c;
+  }
+  return fallback;
+}
+
+// Drop vectors of zero length (a facet touching the plane at one vertex) so every contour vector
+// has a direction; the loop stays closed because its neighbours share that point.
+template <class Chain>
+void drop_zero_length(Chain& chain, bool closed) {
+  const std::size_t n = chain.facets.size();
+  std::size_t w = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::size_t j = closed ? (i + 1) % n : i + 1;
+    if (chain.points[i] == chain.points[j]) continue;
+    chain.points[w] = chain.points[i];
+    chain.facets[w] = chain.facets[i];
+    ++w;
+  }
+  if (!closed) chain.points[w] = chain.points[n];
+  chain.facets.resize(w);
+  chain.points.resize(closed ? w : w + 1);
+}
+
+Slice slice_one(const Mesh& mesh, std::span<const std::int32_t> faces, double z,
+                const SliceParams& params, Scratch& s) {
+  Slice slice;
+  slice.z_mm = z;
+  collect_segments(mesh, faces, z, s.segments);
+  const auto n = static_cast<std::int32_t>(s.segments.size());
+  s.next_same_start.assign(static_cast<std::size_t>(n), -1);
+  s.used.assign(static_cast<std::size_t>(n), 0);
+  for (std::int32_t i = n - 1; i >= 0; --i) {  // reverse, so lists come out in segment order
+    const Segment& seg = s.segments[static_cast<std::size_t>(i)];
+    auto& head = s.start_head[static_cast<std::size_t>(seg.start_edge)];
+    s.next_same_start[static_cast<std::size_t>(i)] = head;
+    head = i;
+    ++s.ends_at[static_cast<std::size_t>(seg.end_edge)];
+  }
+
+  std::vector<Loop> loops;
+  std::vector<int> loop_shell;
+  auto trace = [&](std::int32_t first) {
+    const Segment& head = s.segments[static_cast<std::size_t>(first)];
+    const std::int32_t shell = mesh.shell_id[static_cast<std::size_t>(head.face)];
+    Loop loop;
+    std::int32_t cur = first;
+    bool closed = false;
+    for (;;) {
+      s.used[static_cast<std::size_t>(cur)] = 1;
+      const Segment& seg = s.segments[static_cast<std::size_t>(cur)];
+      loop.points.push_back(edge_point(mesh, seg.start_edge, z));
+      loop.facets.push_back(seg.face);
+      if (seg.end_edge == head.start_edge) {  // back where we started
+        closed = true;
+        break;
+      }
+      const std::int32_t nxt = next_segment(mesh, s, seg.end_edge, shell);
+      if (nxt < 0) {  // the chain ends on a boundary edge of an open mesh
+        loop.points.push_back(edge_point(mesh, seg.end_edge, z));
+        break;
+      }
+      cur = nxt;
+    }
+    if (closed) {
+      drop_zero_length(loop, true);
+      if (loop.points.size() >= 3) {
+        loops.push_back(std::move(loop));
+        loop_shell.push_back(shell);
+      }
+    } else {
+      OpenChain chain;
+      chain.points = std::move(loop.points);
+      chain.facets = std::move(loop.facets);
+      drop_zero_length(chain, false);
+      slice.open_chains.push_back(std::move(chain));
+    }
+  };
+  // Open chains first, from segments nothing leads into, so each is traced from its true start.
+  for (std::int32_t i = 0; i < n; ++i) {
+    if (s.used[static_cast<std::size_t>(i)]) continue;
+    if (s.ends_at[static_cast<std::size_t>(s.segments[static_cast<std::size_t>(i)].start_edge)] == 0) trace(i);
+  }
+  for (std::int32_t i = 0; i < n; ++i)
+    if (!s.used[static_cast<std::size_t>(i)]) trace(i);
+
+  for (const Segment& seg : s.segments) {  // reset the per-edge tables for the next slice
+    s.start_head[static_cast<std::size_t>(seg.start_edge)] = -1;
+    s.ends_at[static_cast<std::size_t>(seg.end_edge)] = 0;
+  }
+
+  if (!slice.open_chains.empty()) {
+    if (params.gap_close_mm > 0.0) {
+      std::vector<OpenChain> pending = slice.open_chains;
+      for (Loop& loop : detail::close_gaps(pending, params.gap_close_mm, slice.warnings)) {
+        loops.push_back(std::move(loop));
+        loop_shell.push_back(-1);
+      }
+    } else {
+      slice.warnings.push_back(fmt::format("z={:.4f} mm: {} open chain(s) left open (gap rule disabled)",
+                                           z, slice.open_chains.size()));
+    }
+  }
+
+  for (Loop& loop : loops) detail::compute_area(loop);
+  detail::compute_nesting(loops);
+  if (detail::needs_union(loops, loop_shell)) {
+    loops = detail::union_of_loops(loops);
+    for (Loop& loop : loops) detail::compute_area(loop);
+    detail::compute_nesting(loops);
+    slice.warnings.push_back(
+        fmt::format("z={:.4f} mm: overlapping shells, contours replaced by their union", z));
+  }
+  slice.loops = std::move(loops);
+  return slice;
+}
+
+}  // namespace
+
+int Slice::outer_count() const {
+  return static_cast<int>(std::count_if(loops.begin(), loops.end(), [](const Loop& l) { return !l.is_hole(); }));
+}
+int Slice::hole_count() const {
+  return static_cast<int>(std::count_if(loops.begin(), loops.end(), [](const Loop& l) { return l.is_hole(); }));
+}
+double Slice::net_area_mm2() const {
+  double a = 0.0;
+  for (const Loop& l : loops) a += l.area_mm2;
+  return a;
+}
+
+ContourVector Slice::vector(const Mesh& mesh, std::size_t loop, std::size_t index) const {
+  const Loop& l = loops.at(loop);
+  ContourVector v;
+  v.start_mm = l.points.at(index);
+  v.end_mm = l.points[(index + 1) % l.points.size()];
+  v.z_mm = z_mm;
+  v.facet = l.facets[index];
+  if (v.facet >= 0) {
+    v.normal = mesh.normals[static_cast<std::size_t>(v.facet)];
+    v.surface_id = mesh.surface_id[static_cast<std::size_t>(v.facet)];
+  } else {
+    // A gap vector: the horizontal normal on its right, where the outside is (t × z).
+    const Eigen::Vector2d d = (v.end_mm - v.start_mm).normalized();
+    v.normal = Eigen::Vector3d(d.y(), -d.x(), 0.0);
+  }
+  return v;
+}
+
+std::vector<double> heights_by_step(double height_mm, double step_mm) {
+  std::vector<double> zs;
+  if (!(step_mm > 0.0) || !(height_mm > 0.0)) return zs;
+  const auto count = static_cast<std::size_t>(std::floor(height_mm / step_mm + 0.5));
+  zs.reserve(count);
+  for (std::size_t i = 0; i < count; ++i) zs.push_back((static_cast<double>(i) + 0.5) * step_mm);
+  return zs;
+}
+
+std::expected<std::vector<Slice>, Error> slice_mesh(const Mesh& mesh, std::span<const double> zs,
+                                                    const SliceParams& params) {
+  if (mesh.faces.empty()) return std::unexpected(Error{ErrorCode::empty_mesh, "slice: the mesh has no facets"});
+  for (std::size_t i = 0; i < zs.size(); ++i)
+    if (!std::isfinite(zs[i]))
+      return std::unexpected(Error{ErrorCode::invalid_argument, fmt::format("slice: height #{} is not finite", i)});
+  if (!(params.gap_close_mm >= 0.0))
+    return std::unexpected(Error{ErrorCode::invalid_argument, "slice: gap_close_mm must be >= 0"});
+
+  // Bucket facets by the planes they cross (CSR): a facet crosses z iff zmin < z <= zmax.
+  std::vector<std::size_t> order(zs.size());
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return zs[a] < zs[b]; });
+  std::vector<double> sorted_z(zs.size());
+  for (std::size_t i = 0; i < order.size(); ++i) sorted_z[i] = zs[order[i]];
+
+  const std::size_t nf = mesh.faces.size();
+  std::vector<std::uint32_t> first(nf), last(nf);  // plane range [first, last) per facet
+  std::vector<std::int32_t> offsets(sorted_z.size() + 1, 0);
+  for (std::size_t f = 0; f < nf; ++f) {
+    const auto& t = mesh.faces[f];
+    const double z0 = mesh.vertices[static_cast<std::size_t>(t[0])].z();
+    const double z1 = mesh.vertices[static_cast<std::size_t>(t[1])].z();
+    const double z2 = mesh.vertices[static_cast<std::size_t>(t[2])].z();
+    const double lo = std::min({z0, z1, z2}), hi = std::max({z0, z1, z2});
+    first[f] = static_cast<std::uint32_t>(std::upper_bound(sorted_z.begin(), sorted_z.end(), lo) - sorted_z.begin());
+    last[f] = static_cast<std::uint32_t>(std::upper_bound(sorted_z.begin(), sorted_z.end(), hi) - sorted_z.begin());
+    for (std::uint32_t k = first[f]; k < last[f]; ++k) ++offsets[k + 1];
+  }
+  std::partial_sum(offsets.begin(), offsets.end(), offsets.begin());
+  std::vector<std::int32_t> bucket(static_cast<std::size_t>(offsets.back()));
+  {
+    std::vector<std::int32_t> fill(offsets.begin(), offsets.end() - 1);
+    for (std::size_t f = 0; f < nf; ++f)
+      for (std::uint32_t k = first[f]; k < last[f]; ++k) bucket[static_cast<std::size_t>(fill[k]++)] = static_cast<std::int32_t>(f);
+  }
+  first = {};
+  last = {};
+
+  std::vector<Slice> out(zs.size());
+  tbb::enumerable_thread_specific<Scratch> scratch([&] {
+    Scratch s;
+    s.start_head.assign(mesh.edges.size(), -1);
+    s.ends_at.assign(mesh.edges.size(), 0);
+    return s;
+  });
+  auto run = [&](std::size_t k) {
+    std::span<const std::int32_t> faces(bucket.data() + offsets[k], bucket.data() + offsets[k + 1]);
+    out[order[k]] = slice_one(mesh, faces, sorted_z[k], params, scratch.local());
+  };
+  if (params.parallel) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, sorted_z.size()),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        for (std::size_t k = r.begin(); k != r.end(); ++k) run(k);
+                      });
+  } else {
+    for (std::size_t k = 0; k < sorted_z.size(); ++k) run(k);
+  }
+  return out;
+}
+
+}  // namespace lamina

@@ -1,0 +1,170 @@
+// Overlapping shells (CAD bodies exported as one file without a boolean union) must slice to the
+// union of the solids. The loops are split where loops of different shells cross; a piece stays
+// on the boundary iff the total winding number just to its right (its outside) is 0 while its left
+// is inside — i.e. the winding of all *other* loops at its midpoint, plus this loop's own winding
+// on its right (0 for CCW, -1 for CW), is exactly 0. Surviving pieces keep their facet, so the
+// contour vectors still know the facet normal and surface they came from.
+#include "slice_internal.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+namespace lamina::detail {
+namespace {
+
+struct Seg {
+  Eigen::Vector2d a, b;
+  std::size_t loop, index;
+  double xmin, xmax, ymin, ymax;
+};
+
+double orient(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c) {
+  return (b.x() - a.x()) * (c.y() - a.y()) - (b.y() - a.y()) * (c.x() - a.x());
+}
+
+std::vector<Seg> segments_of(const std::vector<Loop>& loops) {
+  std::vector<Seg> segs;
+  for (std::size_t l = 0; l < loops.size(); ++l) {
+    const auto& pts = loops[l].points;
+    for (std::size_t i = 0; i < pts.size(); ++i) {
+      const Eigen::Vector2d& a = pts[i];
+      const Eigen::Vector2d& b = pts[(i + 1) % pts.size()];
+      segs.push_back({a, b, l, i, std::min(a.x(), b.x()), std::max(a.x(), b.x()), std::min(a.y(), b.y()),
+                      std::max(a.y(), b.y())});
+    }
+  }
+  std::sort(segs.begin(), segs.end(), [](const Seg& p, const Seg& q) { return p.xmin < q.xmin; });
+  return segs;
+}
+
+// Sweep in x over segments sorted by xmin; `visit` is called for every properly crossing pair of
+// segments from loops for which `pair_ok(loop_a, loop_b)` holds. Returns early when visit says so.
+template <class PairOk, class Visit>
+void for_each_crossing(const std::vector<Seg>& segs, PairOk pair_ok, Visit visit) {
+  std::vector<std::size_t> active;
+  for (std::size_t s = 0; s < segs.size(); ++s) {
+    const Seg& cur = segs[s];
+    std::size_t w = 0;
+    for (std::size_t k = 0; k < active.size(); ++k) {
+      const Seg& o = segs[active[k]];
+      if (o.xmax < cur.xmin) continue;  // left behind by the sweep
+      active[w++] = active[k];
+      if (o.loop == cur.loop || o.ymax < cur.ymin || o.ymin > cur.ymax || !pair_ok(o.loop, cur.loop)) continue;
+      const double o1 = orient(cur.a, cur.b, o.a), o2 = orient(cur.a, cur.b, o.b);
+      const double o3 = orient(o.a, o.b, cur.a), o4 = orient(o.a, o.b, cur.b);
+      if (((o1 > 0 && o2 < 0) || (o1 < 0 && o2 > 0)) && ((o3 > 0 && o4 < 0) || (o3 < 0 && o4 > 0))) {
+        if (!visit(o, cur, o1 / (o1 - o2), o3 / (o3 - o4))) return;
+      }
+    }
+    active.resize(w);
+    active.push_back(s);
+  }
+}
+
+}  // namespace
+
+bool needs_union(const std::vector<Loop>& loops, const std::vector<int>& loop_shell) {
+  for (const Loop& l : loops)
+    if ((l.depth % 2 == 0) != (l.area_mm2 > 0.0)) return true;
+  bool several_shells = false;
+  for (std::size_t i = 1; i < loop_shell.size(); ++i) several_shells |= loop_shell[i] != loop_shell[0];
+  if (!several_shells) return false;
+  bool crossing = false;
+  for_each_crossing(
+      segments_of(loops), [&](std::size_t a, std::size_t b) { return loop_shell[a] != loop_shell[b]; },
+      [&](const Seg&, const Seg&, double, double) {
+        crossing = true;
+        return false;
+      });
+  return crossing;
+}
+
+std::vector<Loop> union_of_loops(const std::vector<Loop>& loops) {
+  // 1. Split points per (loop, vector): parameter along the vector and the shared point.
+  std::vector<std::vector<std::vector<std::pair<double, Eigen::Vector2d>>>> splits(loops.size());
+  for (std::size_t l = 0; l < loops.size(); ++l) splits[l].resize(loops[l].points.size());
+  for_each_crossing(
+      segments_of(loops), [](std::size_t, std::size_t) { return true; },
+      [&](const Seg& o, const Seg& cur, double t_cur, double t_o) {
+        // One point for both pieces, so chaining by exact equality works.
+        const Eigen::Vector2d p = cur.a + t_cur * (cur.b - cur.a);
+        splits[cur.loop][cur.index].emplace_back(t_cur, p);
+        splits[o.loop][o.index].emplace_back(t_o, p);
+        return true;
+      });
+
+  // 2. Pieces, grouped into runs between crossings; one winding evaluation per run.
+  struct Piece {
+    Eigen::Vector2d a, b;
+    std::int32_t facet;
+  };
+  std::vector<Piece> kept;
+  for (std::size_t l = 0; l < loops.size(); ++l) {
+    const Loop& loop = loops[l];
+    const int own_right = loop.area_mm2 > 0.0 ? 0 : -1;
+    std::vector<Piece> pieces;
+    std::vector<std::size_t> run_start{0};
+    const std::size_t n = loop.points.size();
+    for (std::size_t i = 0; i < n; ++i) {
+      auto& sp = splits[l][i];
+      std::sort(sp.begin(), sp.end(), [](const auto& p, const auto& q) { return p.first < q.first; });
+      Eigen::Vector2d from = loop.points[i];
+      for (const auto& [t, p] : sp) {
+        pieces.push_back({from, p, loop.facets[i]});
+        run_start.push_back(pieces.size());
+        from = p;
+      }
+      pieces.push_back({from, loop.points[(i + 1) % n], loop.facets[i]});
+    }
+    run_start.push_back(pieces.size());
+    for (std::size_t r = 0; r + 1 < run_start.size(); ++r) {
+      if (run_start[r] == run_start[r + 1]) continue;
+      // The longest piece of the run is the least likely to touch another loop.
+      std::size_t probe = run_start[r];
+      for (std::size_t k = run_start[r]; k < run_start[r + 1]; ++k)
+        if ((pieces[k].b - pieces[k].a).squaredNorm() > (pieces[probe].b - pieces[probe].a).squaredNorm()) probe = k;
+      const Eigen::Vector2d mid = 0.5 * (pieces[probe].a + pieces[probe].b);
+      int w = own_right;
+      for (std::size_t o = 0; o < loops.size(); ++o)
+        if (o != l) w += winding_number(loops[o], mid);
+      if (w == 0)
+        for (std::size_t k = run_start[r]; k < run_start[r + 1]; ++k) kept.push_back(pieces[k]);
+    }
+  }
+
+  // 3. Chain the kept pieces by exact end-point equality.
+  auto key = [](const Eigen::Vector2d& p) { return std::pair<double, double>(p.x(), p.y()); };
+  std::multimap<std::pair<double, double>, std::size_t> by_start;
+  for (std::size_t i = 0; i < kept.size(); ++i) by_start.emplace(key(kept[i].a), i);
+  std::vector<char> used(kept.size(), 0);
+  std::vector<Loop> out;
+  for (std::size_t first = 0; first < kept.size(); ++first) {
+    if (used[first]) continue;
+    Loop loop;
+    std::size_t cur = first;
+    bool closed = false;
+    for (;;) {
+      used[cur] = 1;
+      loop.points.push_back(kept[cur].a);
+      loop.facets.push_back(kept[cur].facet);
+      if (kept[cur].b == kept[first].a) {
+        closed = true;
+        break;
+      }
+      auto [lo, hi] = by_start.equal_range(key(kept[cur].b));
+      std::size_t nxt = kept.size();
+      for (auto it = lo; it != hi; ++it)
+        if (!used[it->second]) {
+          nxt = it->second;
+          break;
+        }
+      if (nxt == kept.size()) break;
+      cur = nxt;
+    }
+    if (closed && loop.points.size() >= 3) out.push_back(std::move(loop));
+  }
+  return out;
+}
+
+}  // namespace lamina::detail
