@@ -1,0 +1,40 @@
+#include "model_loading.hpp"
+
+#include "lamina/core/mesh_io.hpp"
+
+#include <chrono>
+#include <numbers>
+
+namespace lamina::cli {
+namespace {
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+}  // namespace
+
+MeshParams mesh_params_from(const ModelOptions& o) {
+  MeshParams p;
+  p.scale_to_mm = o.units == "in" ? 25.4 : 1.0;
+  p.axis = o.axis == "x" ? BuildAxis::x : o.axis == "y" ? BuildAxis::y : BuildAxis::z;
+  p.sharp_angle_rad = o.sharp_angle_deg * std::numbers::pi / 180.0;
+  p.weld_tolerance_rel = o.weld_tolerance_rel;
+  return p;
+}
+
+std::expected<LoadedModel, Error> load_model(const ModelOptions& options) {
+  LoadedModel out;
+  auto t0 = std::chrono::steady_clock::now();
+  auto soup = read_mesh_file(options.path);
+  out.read_s = seconds_since(t0);
+  if (!soup) return std::unexpected(soup.error());
+  out.format = soup->format;
+  out.notes = soup->notes;
+  t0 = std::chrono::steady_clock::now();
+  auto mesh = build_mesh(*soup, mesh_params_from(options));
+  out.topology_s = seconds_since(t0);
+  if (!mesh) return std::unexpected(mesh.error());
+  out.mesh = std::move(*mesh);
+  return out;
+}
+
+}  // namespace lamina::cli
