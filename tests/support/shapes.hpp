@@ -25,8 +25,9 @@
 // them rounded to float, so compare with a tolerance, not exactly: 1e-6 * pi * R^2 (R the
 // largest radius of the shape) covers the float rounding with margin; measured worst cases are
 // 10x-100x below it (e.g. 5e-4 mm^2 for a section of ~7000 mm^2), anywhere in z, tips included.
-// At heights where the plane contains a horizontal face (tube caps, pole-free torus faces) the
-// value returned is the limit from inside the solid; tests should not slice exactly there.
+// At heights where the plane contains a horizontal face (tube caps; the top and bottom faces of
+// a torus whose minor_segments is even but not a multiple of 4) the value returned is the limit
+// from inside the solid; tests should not slice exactly there.
 #include <lamina/core/triangle_soup.hpp>
 
 #include <Eigen/Core>
