@@ -1,0 +1,139 @@
+// parse_stl: decides between binary and ASCII STL from the content, then hands over.
+//
+// Binary is recognised by its size (84 + 50·n ≤ file size, n = the 32-bit count at byte 80), not
+// by the first word: several real binary files start their 80-byte header with "solid".
+#include "lamina/core/mesh_io.hpp"
+#include "mesh_io_text.hpp"
+#include "stl_detail.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <cstring>
+#include <string>
+
+namespace lamina {
+namespace {
+
+constexpr std::size_t kHeaderBytes = 80;
+constexpr std::size_t kPreambleBytes = 84;  // header + triangle count
+constexpr std::size_t kTriangleBytes = 50;  // normal, 3 corners (12 float32) + 2-byte attribute
+constexpr std::size_t kTextProbeBytes = 512;
+// A count above this (a 5 GB file) in a file too short for it says "some other binary format"
+// rather than "a truncated STL".
+constexpr std::uint64_t kImplausibleTriangles = 100'000'000;
+
+std::uint32_t read_u32_le(const std::byte* p) {
+  const auto b = [p](int i) { return static_cast<std::uint32_t>(std::to_integer<unsigned char>(p[i])); };
+  return b(0) | (b(1) << 8) | (b(2) << 16) | (b(3) << 24);
+}
+
+// True when the first bytes contain no control character other than whitespace (bytes ≥ 0x80 are
+// allowed: names may be UTF-8). Binary STL data almost always has 0x00 bytes within them.
+bool prefix_is_text(std::string_view text) {
+  const std::size_t n = std::min(text.size(), kTextProbeBytes);
+  for (std::size_t i = 0; i < n; ++i) {
+    auto c = static_cast<unsigned char>(text[i]);
+    if (c < 0x20 && !detail::is_space(static_cast<char>(c))) return false;
+    if (c == 0x7f) return false;
+  }
+  return true;
+}
+
+std::string_view skip_bom_and_space(std::string_view text) {
+  if (text.starts_with("\xEF\xBB\xBF")) text.remove_prefix(3);
+  std::size_t i = 0;
+  while (i < text.size() && detail::is_space(text[i])) ++i;
+  return text.substr(i);
+}
+
+bool starts_with_solid_keyword(std::string_view text) {
+  std::string_view t = skip_bom_and_space(text);
+  return detail::istarts_with(t, "solid") && (t.size() == 5 || detail::is_space(t[5]));
+}
+
+}  // namespace
+
+namespace detail {
+
+void StlNormalStats::append_notes(std::vector<ReadNote>& notes, std::string_view name) const {
+  if (count == 0) return;
+  if (zero == count) {
+    notes.push_back({"stored_normals_zero",
+                     fmt::format("{}: all {} stored facet normals are (0, 0, 0); normals come from the winding",
+                                 name, count)});
+    return;
+  }
+  if (not_unit > 0 || zero > 0) {
+    const std::string lengths =
+        not_unit > 0 ? fmt::format(", lengths {:.3g} to {:.3g}", min_length, max_length) : std::string();
+    notes.push_back({"stored_normals_not_unit",
+                     fmt::format("{}: {} of {} stored facet normals are not unit length ({} zero{}); normals come "
+                                 "from the winding",
+                                 name, not_unit + zero, count, zero, lengths)});
+  }
+}
+
+void append_non_finite_note(std::vector<ReadNote>& notes, std::string_view name, std::size_t non_finite_values,
+                            std::size_t triangles_affected) {
+  if (non_finite_values == 0) return;
+  notes.push_back({"non_finite_coordinates",
+                   fmt::format("{}: {} corner coordinates in {} triangles are NaN or infinite (kept as read)", name,
+                               non_finite_values, triangles_affected)});
+}
+
+}  // namespace detail
+
+std::expected<TriangleSoup, Error> parse_stl(std::span<const std::byte> bytes, std::string_view name) {
+  const std::size_t size = bytes.size();
+  if (size == 0) return std::unexpected(Error{ErrorCode::empty_mesh, fmt::format("{}: the file is empty", name)});
+
+  const std::string_view text(reinterpret_cast<const char*>(bytes.data()), size);
+  const bool text_prefix = prefix_is_text(text);
+  const bool ascii_like = text_prefix && starts_with_solid_keyword(text);
+
+  std::uint64_t declared = 0;
+  bool binary_fits = false;
+  if (size >= kPreambleBytes) {
+    declared = read_u32_le(bytes.data() + kHeaderBytes);
+    binary_fits = kPreambleBytes + kTriangleBytes * declared <= size;
+  }
+
+  if (ascii_like) {
+    auto ascii = detail::parse_stl_ascii(text, name);
+    // A text-looking header whose size still matches a binary layout: trust the size.
+    if (ascii || !binary_fits) return ascii;
+    return detail::parse_stl_binary(bytes, name);
+  }
+  if (binary_fits) return detail::parse_stl_binary(bytes, name);
+
+  if (text_prefix) {
+    return std::unexpected(Error{
+        ErrorCode::unknown_format,
+        fmt::format("{}: not an STL file: text that does not start with 'solid' (starts with {})", name,
+                    detail::quote_excerpt(skip_bom_and_space(text).substr(0, 24)))});
+  }
+  if (size < kPreambleBytes) {
+    return std::unexpected(
+        Error{ErrorCode::unknown_format,
+              fmt::format("{}: not an STL file: {} bytes is shorter than a binary STL's 84-byte header and count, "
+                          "and it is not ASCII STL",
+                          name, size)});
+  }
+  if (declared > kImplausibleTriangles) {
+    return std::unexpected(Error{
+        ErrorCode::unknown_format,
+        fmt::format("{}: not an STL file: not text, and read as binary STL it would declare {} triangles "
+                    "({} bytes) in a file of {} bytes",
+                    name, declared, kPreambleBytes + kTriangleBytes * declared, size)});
+  }
+  const std::uint64_t complete = (size - kPreambleBytes) / kTriangleBytes;
+  return std::unexpected(Error{
+      ErrorCode::truncated_file,
+      fmt::format("{}: binary STL declares {} triangles ({} bytes) but the file has {} bytes: {} complete "
+                  "triangles present (truncated, or not an STL file)",
+                  name, declared, kPreambleBytes + kTriangleBytes * declared, size, complete)});
+}
+
+}  // namespace lamina

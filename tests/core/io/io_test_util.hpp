@@ -1,0 +1,124 @@
+#pragma once
+// Helpers for the mesh reader tests: binary STL bytes built in memory (explicitly little-endian),
+// temporary folders, and small geometry sums over a TriangleSoup.
+#include "lamina/core/triangle_soup.hpp"
+
+#include <Eigen/Geometry>
+
+#include <array>
+#include <bit>
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace lamina::test {
+
+// One binary STL record: stored normal, three corners.
+struct StlFacet {
+  std::array<float, 3> normal;
+  std::array<float, 3> a, b, c;
+};
+
+inline void put_u32_le(std::vector<std::byte>& out, std::uint32_t v) {
+  for (int i = 0; i < 4; ++i) out.push_back(static_cast<std::byte>((v >> (8 * i)) & 0xffu));
+}
+
+inline void put_f32_le(std::vector<std::byte>& out, float f) { put_u32_le(out, std::bit_cast<std::uint32_t>(f)); }
+
+// A binary STL: `header` (cut or zero-padded to 80 bytes), the count (`declared_count` when given,
+// else facets.size()), the facets, then `trailing` extra bytes of value 0xAB.
+inline std::vector<std::byte> binary_stl(std::span<const StlFacet> facets, std::string_view header = "lamina test",
+                                         std::size_t trailing = 0, std::int64_t declared_count = -1) {
+  std::vector<std::byte> out;
+  for (std::size_t i = 0; i < 80; ++i)
+    out.push_back(i < header.size() ? static_cast<std::byte>(header[i]) : std::byte{0});
+  put_u32_le(out, declared_count >= 0 ? static_cast<std::uint32_t>(declared_count)
+                                      : static_cast<std::uint32_t>(facets.size()));
+  for (const StlFacet& f : facets) {
+    for (float v : f.normal) put_f32_le(out, v);
+    for (const auto* corner : {&f.a, &f.b, &f.c})
+      for (float v : *corner) put_f32_le(out, v);
+    out.push_back(std::byte{0});
+    out.push_back(std::byte{0});
+  }
+  for (std::size_t i = 0; i < trailing; ++i) out.push_back(std::byte{0xAB});
+  return out;
+}
+
+inline std::span<const std::byte> as_bytes(std::string_view s) {
+  return {reinterpret_cast<const std::byte*>(s.data()), s.size()};
+}
+
+// A fresh folder under the system temp dir, removed with its content on destruction.
+class TempDir {
+ public:
+  TempDir() {
+    std::random_device rd;
+    for (;;) {
+      path_ = std::filesystem::temp_directory_path() /
+              ("lamina_io_test_" + std::to_string(rd()) + "_" + std::to_string(rd()));
+      if (std::filesystem::create_directory(path_)) break;
+    }
+  }
+  ~TempDir() {
+    std::error_code ec;
+    std::filesystem::remove_all(path_, ec);
+  }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+
+  const std::filesystem::path& path() const { return path_; }
+
+  std::filesystem::path write(const std::string& name, std::span<const std::byte> bytes) const {
+    const auto p = path_ / name;
+    std::ofstream f(p, std::ios::binary);
+    f.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+    return p;
+  }
+  std::filesystem::path write(const std::string& name, std::string_view text) const {
+    return write(name, as_bytes(text));
+  }
+
+ private:
+  std::filesystem::path path_;
+};
+
+inline Eigen::Vector3d triangle_cross(const TriangleSoup& soup, std::size_t t) {
+  const Eigen::Vector3d a = soup.corners[3 * t].cast<double>();
+  const Eigen::Vector3d b = soup.corners[3 * t + 1].cast<double>();
+  const Eigen::Vector3d c = soup.corners[3 * t + 2].cast<double>();
+  return (b - a).cross(c - a);
+}
+
+// Σ |triangle area|.
+inline double unsigned_area(const TriangleSoup& soup) {
+  double sum = 0.0;
+  for (std::size_t t = 0; t < soup.triangle_count(); ++t) sum += 0.5 * triangle_cross(soup, t).norm();
+  return sum;
+}
+
+// Σ v0·(v1×v2)/6, in double (divergence theorem; positive for outward winding).
+inline double signed_volume(const TriangleSoup& soup) {
+  double sum = 0.0;
+  for (std::size_t t = 0; t < soup.triangle_count(); ++t) {
+    const Eigen::Vector3d a = soup.corners[3 * t].cast<double>();
+    const Eigen::Vector3d b = soup.corners[3 * t + 1].cast<double>();
+    const Eigen::Vector3d c = soup.corners[3 * t + 2].cast<double>();
+    sum += a.dot(b.cross(c)) / 6.0;
+  }
+  return sum;
+}
+
+inline const ReadNote* find_note(const TriangleSoup& soup, std::string_view code) {
+  for (const ReadNote& n : soup.notes)
+    if (n.code == code) return &n;
+  return nullptr;
+}
+
+}  // namespace lamina::test
