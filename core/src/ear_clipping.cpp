@@ -48,6 +48,25 @@ void triangulate_polygon(std::span<const Eigen::Vector3f> corners, std::vector<s
   }
   normal /= normal_len;
 
+  // A convex quadrilateral (the common case) is the fan (0 1 2), (0 2 3): every corner turns left
+  // about the normal by more than the straight tolerance. (With five corners or more, all-left
+  // turns are not enough, a pentagram has them, so those always go through ear clipping.)
+  if (n == 4) {
+    bool convex_quad = true;
+    for (std::uint32_t b = 0; b < 4 && convex_quad; ++b) {
+      const Eigen::Vector3d a = corners[(b + 3) % 4].cast<double>();
+      const Eigen::Vector3d m = corners[b].cast<double>();
+      const Eigen::Vector3d c = corners[(b + 1) % 4].cast<double>();
+      const double turn = (m - a).cross(c - m).dot(normal);
+      convex_quad = turn > 0.0 &&
+                    turn * turn > kStraightSine * kStraightSine * (m - a).squaredNorm() * (c - m).squaredNorm();
+    }
+    if (convex_quad) {
+      fan(n, out);
+      return;
+    }
+  }
+
   // In-plane basis (u, v) with u × v = normal: the polygon is counter-clockwise in (u, v).
   const Eigen::Vector3d axis = std::abs(normal.x()) < 0.6 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
   const Eigen::Vector3d u = axis.cross(normal).normalized();
@@ -68,9 +87,17 @@ void triangulate_polygon(std::span<const Eigen::Vector3f> corners, std::vector<s
   const auto cross = [&s](std::uint32_t a, std::uint32_t b, std::uint32_t c) {
     return (s.x[b] - s.x[a]) * (s.y[c] - s.y[b]) - (s.y[b] - s.y[a]) * (s.x[c] - s.x[b]);
   };
-  const auto length = [&s](std::uint32_t a, std::uint32_t b) { return std::hypot(s.x[b] - s.x[a], s.y[b] - s.y[a]); };
-  const auto straight_tolerance = [&](std::uint32_t a, std::uint32_t b, std::uint32_t c) {
-    return kStraightSine * length(a, b) * length(b, c);
+  const auto length2 = [&s](std::uint32_t a, std::uint32_t b) {
+    const double dx = s.x[b] - s.x[a], dy = s.y[b] - s.y[a];
+    return dx * dx + dy * dy;
+  };
+  // |turn at b| ≤ kStraightSine · |ab| · |bc|, compared squared.
+  const auto straight = [&](std::uint32_t a, std::uint32_t b, std::uint32_t c) {
+    const double turn = cross(a, b, c);
+    return turn * turn <= kStraightSine * kStraightSine * length2(a, b) * length2(b, c);
+  };
+  const auto convex = [&](std::uint32_t a, std::uint32_t b, std::uint32_t c) {
+    return cross(a, b, c) > 0.0 && !straight(a, b, c);
   };
   const auto same_point = [&s](std::uint32_t a, std::uint32_t b) { return s.x[a] == s.x[b] && s.y[a] == s.y[b]; };
   // Point r inside or on triangle (a, b, c), which is counter-clockwise.
@@ -82,7 +109,7 @@ void triangulate_polygon(std::span<const Eigen::Vector3f> corners, std::vector<s
   };
   const auto is_ear = [&](std::uint32_t b) {
     const std::uint32_t a = s.prev[b], c = s.next[b];
-    if (!(cross(a, b, c) > straight_tolerance(a, b, c))) return false;  // reflex or straight
+    if (!convex(a, b, c)) return false;  // reflex or straight
     for (std::uint32_t r = s.next[c]; r != a; r = s.next[r]) {
       if (same_point(r, a) || same_point(r, b) || same_point(r, c)) continue;
       if (inside(r, a, b, c)) return false;
@@ -140,7 +167,7 @@ void triangulate_polygon(std::span<const Eigen::Vector3f> corners, std::vector<s
   const auto flip_sliver = [&](std::size_t t) {
     for (int k = 0; k < 3; ++k) {
       const std::uint32_t a = out[t][k], m = out[t][(k + 1) % 3], b = out[t][(k + 2) % 3];
-      if (std::abs(cross(a, m, b)) > straight_tolerance(a, m, b)) continue;
+      if (!straight(a, m, b)) continue;
       // m strictly between a and b.
       if (!((s.x[m] - s.x[a]) * (s.x[b] - s.x[m]) + (s.y[m] - s.y[a]) * (s.y[b] - s.y[m]) > 0.0)) continue;
       for (std::size_t w = first_out; w < end_out; ++w) {

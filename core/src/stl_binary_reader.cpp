@@ -13,9 +13,6 @@
 namespace lamina::detail {
 namespace {
 
-constexpr std::size_t kPreambleBytes = 84;
-constexpr std::size_t kTriangleBytes = 50;
-
 // Twelve little-endian float32 starting at p (any alignment, any host byte order).
 inline void load_floats_le(const std::byte* p, float (&out)[12]) {
   if constexpr (std::endian::native == std::endian::little) {
@@ -29,32 +26,27 @@ inline void load_floats_le(const std::byte* p, float (&out)[12]) {
   }
 }
 
+std::uint32_t read_count(std::span<const std::byte> bytes) {
+  std::uint32_t count;
+  std::memcpy(&count, bytes.data() + kStlHeaderBytes, 4);
+  return std::endian::native == std::endian::little ? count : std::byteswap(count);
+}
+
 }  // namespace
 
-std::expected<TriangleSoup, Error> parse_stl_binary(std::span<const std::byte> bytes, std::string_view name) {
-  std::uint32_t count_le;
-  std::memcpy(&count_le, bytes.data() + 80, 4);
-  const std::uint32_t count =
-      std::endian::native == std::endian::little ? count_le : std::byteswap(count_le);
-  if (count == 0) {
-    return std::unexpected(Error{
-        ErrorCode::empty_mesh,
-        fmt::format("{}: binary STL declares 0 triangles ({} bytes after the header)", name, bytes.size() - 84)});
-  }
+StlBinaryDecoder::StlBinaryDecoder(std::uint32_t count) : count_(count) {
+  soup_.format = "stl-binary";
+  soup_.corners.resize(std::size_t{3} * count);  // Eigen vectors are left uninitialised here
+}
 
-  TriangleSoup soup;
-  soup.format = "stl-binary";
-  soup.corners.resize(std::size_t{3} * count);  // Eigen vectors are left uninitialised here
-
-  StlNormalStats normals;
+void StlBinaryDecoder::decode(const std::byte* p, std::size_t n) {
+  Eigen::Vector3f* out = soup_.corners.data() + 3 * done_;
   std::size_t non_finite = 0;
   std::size_t non_finite_triangles = 0;
-  const std::byte* p = bytes.data() + kPreambleBytes;
-  Eigen::Vector3f* out = soup.corners.data();
-  for (std::uint32_t t = 0; t < count; ++t, p += kTriangleBytes, out += 3) {
+  for (std::size_t t = 0; t < n; ++t, p += kStlTriangleBytes, out += 3) {
     float f[12];
     load_floats_le(p, f);
-    normals.add(f[0], f[1], f[2]);
+    normals_.add(f[0], f[1], f[2]);
     out[0] = Eigen::Vector3f(f[3], f[4], f[5]);
     out[1] = Eigen::Vector3f(f[6], f[7], f[8]);
     out[2] = Eigen::Vector3f(f[9], f[10], f[11]);
@@ -63,18 +55,35 @@ std::expected<TriangleSoup, Error> parse_stl_binary(std::span<const std::byte> b
     non_finite += bad;
     non_finite_triangles += bad != 0;
   }
+  done_ += n;
+  non_finite_ += non_finite;
+  non_finite_triangles_ += non_finite_triangles;
+}
 
-  const std::size_t used = kPreambleBytes + kTriangleBytes * std::size_t{count};
-  if (bytes.size() > used) {
-    const std::size_t extra = bytes.size() - used;
-    soup.notes.push_back(
+TriangleSoup StlBinaryDecoder::finish(std::string_view name, std::uint64_t file_size) && {
+  const std::uint64_t used = kStlPreambleBytes + kStlTriangleBytes * std::uint64_t{count_};
+  if (file_size > used) {
+    const std::uint64_t extra = file_size - used;
+    soup_.notes.push_back(
         {"trailing_bytes", fmt::format("{}: {} trailing byte{} after the {} declared triangles ignored ({} bytes "
                                        "expected, {} present)",
-                                       name, extra, extra == 1 ? "" : "s", count, used, bytes.size())});
+                                       name, extra, extra == 1 ? "" : "s", count_, used, file_size)});
   }
-  normals.append_notes(soup.notes, name);
-  append_non_finite_note(soup.notes, name, non_finite, non_finite_triangles);
-  return soup;
+  normals_.append_notes(soup_.notes, name);
+  append_non_finite_note(soup_.notes, name, non_finite_, non_finite_triangles_);
+  return std::move(soup_);
+}
+
+std::expected<TriangleSoup, Error> parse_stl_binary(std::span<const std::byte> bytes, std::string_view name) {
+  const std::uint32_t count = read_count(bytes);
+  if (count == 0) {
+    return std::unexpected(Error{ErrorCode::empty_mesh,
+                                 fmt::format("{}: binary STL declares 0 triangles ({} bytes after the header)", name,
+                                             bytes.size() - kStlPreambleBytes)});
+  }
+  StlBinaryDecoder decoder(count);
+  decoder.decode(bytes.data() + kStlPreambleBytes, count);
+  return std::move(decoder).finish(name, bytes.size());
 }
 
 }  // namespace lamina::detail

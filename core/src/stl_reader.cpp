@@ -16,10 +16,6 @@
 namespace lamina {
 namespace {
 
-constexpr std::size_t kHeaderBytes = 80;
-constexpr std::size_t kPreambleBytes = 84;  // header + triangle count
-constexpr std::size_t kTriangleBytes = 50;  // normal, 3 corners (12 float32) + 2-byte attribute
-constexpr std::size_t kTextProbeBytes = 512;
 // A count above this (a 5 GB file) in a file too short for it says "some other binary format"
 // rather than "a truncated STL".
 constexpr std::uint64_t kImplausibleTriangles = 100'000'000;
@@ -32,7 +28,7 @@ std::uint32_t read_u32_le(const std::byte* p) {
 // True when the first bytes contain no control character other than whitespace (bytes ≥ 0x80 are
 // allowed: names may be UTF-8). Binary STL data almost always has 0x00 bytes within them.
 bool prefix_is_text(std::string_view text) {
-  const std::size_t n = std::min(text.size(), kTextProbeBytes);
+  const std::size_t n = std::min(text.size(), detail::kStlTextProbeBytes);
   for (std::size_t i = 0; i < n; ++i) {
     auto c = static_cast<unsigned char>(text[i]);
     if (c < 0x20 && !detail::is_space(static_cast<char>(c))) return false;
@@ -75,6 +71,33 @@ void StlNormalStats::append_notes(std::vector<ReadNote>& notes, std::string_view
   }
 }
 
+StlProbe probe_stl(std::span<const std::byte> prefix, std::uint64_t size) {
+  StlProbe probe;
+  const std::string_view text(reinterpret_cast<const char*>(prefix.data()), prefix.size());
+  probe.text_prefix = prefix_is_text(text);
+  probe.ascii_like = probe.text_prefix && starts_with_solid_keyword(text.substr(0, kStlTextProbeBytes));
+  if (size >= kStlPreambleBytes && prefix.size() >= kStlPreambleBytes) {
+    probe.declared = read_u32_le(prefix.data() + kStlHeaderBytes);
+    probe.binary_fits = kStlPreambleBytes + kStlTriangleBytes * probe.declared <= size;
+  }
+  return probe;
+}
+
+Error stl_short_binary_error(std::string_view name, std::uint64_t declared, std::uint64_t size) {
+  const std::uint64_t needed = kStlPreambleBytes + kStlTriangleBytes * declared;
+  if (declared > kImplausibleTriangles) {
+    return Error{ErrorCode::unknown_format,
+                 fmt::format("{}: not an STL file: not text, and read as binary STL it would declare {} triangles "
+                             "({} bytes) in a file of {} bytes",
+                             name, declared, needed, size)};
+  }
+  const std::uint64_t complete = size < kStlPreambleBytes ? 0 : (size - kStlPreambleBytes) / kStlTriangleBytes;
+  return Error{ErrorCode::truncated_file,
+               fmt::format("{}: binary STL declares {} triangles ({} bytes) but the file has {} bytes: {} complete "
+                           "triangles present (truncated, or not an STL file)",
+                           name, declared, needed, size, complete)};
+}
+
 void append_non_finite_note(std::vector<ReadNote>& notes, std::string_view name, std::size_t non_finite_values,
                             std::size_t triangles_affected) {
   if (non_finite_values == 0) return;
@@ -90,50 +113,29 @@ std::expected<TriangleSoup, Error> parse_stl(std::span<const std::byte> bytes, s
   if (size == 0) return std::unexpected(Error{ErrorCode::empty_mesh, fmt::format("{}: the file is empty", name)});
 
   const std::string_view text(reinterpret_cast<const char*>(bytes.data()), size);
-  const bool text_prefix = prefix_is_text(text);
-  const bool ascii_like = text_prefix && starts_with_solid_keyword(text);
-
-  std::uint64_t declared = 0;
-  bool binary_fits = false;
-  if (size >= kPreambleBytes) {
-    declared = read_u32_le(bytes.data() + kHeaderBytes);
-    binary_fits = kPreambleBytes + kTriangleBytes * declared <= size;
-  }
-
-  if (ascii_like) {
+  const detail::StlProbe probe = detail::probe_stl(bytes, size);
+  if (probe.ascii_like) {
     auto ascii = detail::parse_stl_ascii(text, name);
     // A text-looking header whose size still matches a binary layout: trust the size.
-    if (ascii || !binary_fits) return ascii;
+    if (ascii || !probe.binary_fits) return ascii;
     return detail::parse_stl_binary(bytes, name);
   }
-  if (binary_fits) return detail::parse_stl_binary(bytes, name);
+  if (probe.binary_fits) return detail::parse_stl_binary(bytes, name);
 
-  if (text_prefix) {
+  if (probe.text_prefix) {
     return std::unexpected(Error{
         ErrorCode::unknown_format,
         fmt::format("{}: not an STL file: text that does not start with 'solid' (starts with {})", name,
                     detail::quote_excerpt(skip_bom_and_space(text).substr(0, 24)))});
   }
-  if (size < kPreambleBytes) {
+  if (size < detail::kStlPreambleBytes) {
     return std::unexpected(
         Error{ErrorCode::unknown_format,
               fmt::format("{}: not an STL file: {} bytes is shorter than a binary STL's 84-byte header and count, "
                           "and it is not ASCII STL",
                           name, size)});
   }
-  if (declared > kImplausibleTriangles) {
-    return std::unexpected(Error{
-        ErrorCode::unknown_format,
-        fmt::format("{}: not an STL file: not text, and read as binary STL it would declare {} triangles "
-                    "({} bytes) in a file of {} bytes",
-                    name, declared, kPreambleBytes + kTriangleBytes * declared, size)});
-  }
-  const std::uint64_t complete = (size - kPreambleBytes) / kTriangleBytes;
-  return std::unexpected(Error{
-      ErrorCode::truncated_file,
-      fmt::format("{}: binary STL declares {} triangles ({} bytes) but the file has {} bytes: {} complete "
-                  "triangles present (truncated, or not an STL file)",
-                  name, declared, kPreambleBytes + kTriangleBytes * declared, size, complete)});
+  return std::unexpected(detail::stl_short_binary_error(name, probe.declared, size));
 }
 
 }  // namespace lamina

@@ -55,6 +55,32 @@ TEST(MeshFile, StlIsDetectedFromContentWhateverTheExtension) {
   EXPECT_EQ(ascii->corners[2], Eigen::Vector3f(0, 1, 0));
 }
 
+TEST(MeshFile, LargeBinaryStlReadInChunksMatchesParsingInMemory) {
+  // 45 000 facets = 2.25 MB: several 1 MiB chunks, with records straddling chunk boundaries.
+  std::vector<StlFacet> facets;
+  for (int i = 0; i < 45000; ++i) {
+    const float f = static_cast<float>(i);
+    facets.push_back({{0, 0, i % 3 == 0 ? 0.0f : 1.0f}, {f, -f, 0.5f * f}, {f + 0.25f, 1e-3f * f, -f}, {-f, f, f * f}});
+  }
+  const auto bytes = binary_stl(facets, "solid big binary", 3);
+  TempDir dir;
+  auto from_file = read_mesh_file(dir.write("big.stl", bytes));
+  auto in_memory = parse_stl(bytes, (dir.path() / "big.stl").string());
+  ASSERT_TRUE(from_file) << from_file.error().message;
+  ASSERT_TRUE(in_memory) << in_memory.error().message;
+  EXPECT_EQ(from_file->format, "stl-binary");
+  ASSERT_EQ(from_file->triangle_count(), 45000u);
+  EXPECT_TRUE(from_file->corners == in_memory->corners);
+  EXPECT_EQ(from_file->corners[3 * 44999 + 2], Eigen::Vector3f(-44999.0f, 44999.0f, 44999.0f * 44999.0f));
+  ASSERT_EQ(from_file->notes.size(), in_memory->notes.size());
+  for (std::size_t i = 0; i < from_file->notes.size(); ++i) {
+    EXPECT_EQ(from_file->notes[i].code, in_memory->notes[i].code);
+    EXPECT_EQ(from_file->notes[i].message, in_memory->notes[i].message);
+  }
+  EXPECT_NE(test::find_note(*from_file, "trailing_bytes"), nullptr);
+  EXPECT_NE(test::find_note(*from_file, "stored_normals_not_unit"), nullptr);  // a third are zero
+}
+
 TEST(MeshFile, ObjGoesByExtensionOrRecognisableContent) {
   TempDir dir;
   for (const char* name : {"q.obj", "Q.OBJ", "q.txt"}) {

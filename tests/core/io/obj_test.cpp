@@ -117,6 +117,13 @@ TEST(Obj, NonConvexLShapeIsTriangulatedCorrectly) {
   for (std::size_t t = 0; t < soup->triangle_count(); ++t) EXPECT_LT(triangle_cross(*soup, t).z(), 0.0) << t;
 }
 
+TEST(Obj, NonConvexQuadIsNotFanned) {
+  // A dart whose reflex corner is corner 1: the fan (0 1 2), (0 2 3) would flip its first triangle.
+  const std::vector<Eigen::Vector2d> dart = {{0, 0}, {2, 1}, {4, 0}, {2, 3}};
+  expect_exact_cover(dart, 4.0, Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY());
+  expect_exact_cover(dart, 4.0, Eigen::Vector3d(0, 0, 2), Eigen::Vector3d(1, 1, 0));
+}
+
 TEST(Obj, StarAndCombPolygonsAreTriangulatedCorrectly) {
   // Five-pointed star, outer radius 2, inner 0.8: area = 5 · R · r · sin(36°).
   std::vector<Eigen::Vector2d> star;
