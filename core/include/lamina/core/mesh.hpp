@@ -10,6 +10,7 @@
 #include <expected>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace lamina {
@@ -67,20 +68,31 @@ struct MeshSummary {
   std::size_t nonmanifold_edges = 0;
 };
 
+// One shell: a connected set of facets joined through manifold edges (exactly two facets).
+struct ShellInfo {
+  std::int32_t facets = 0;
+  double volume_mm3 = 0.0;  // signed, after orientation: > 0 a solid, < 0 a cavity
+  bool closed = false;      // every edge of the shell is balanced (no boundary, no winding conflict)
+  int depth = 0;            // how many other closed shells enclose it (odd = cavity)
+};
+
 struct Mesh {
   std::vector<Eigen::Vector3d> vertices;               // mm, build frame, lowest point at z = 0
   std::vector<std::array<std::int32_t, 3>> faces;      // wound outward (CCW seen from outside)
   std::vector<Eigen::Vector3d> normals;                // unit facet normals, from the winding
   std::vector<std::int32_t> surface_id;                // per facet: region bounded by sharp edges
-  std::vector<std::int32_t> shell_id;                  // per facet: connected component
+  std::vector<std::int32_t> shell_id;                  // per facet: component joined by manifold edges
   std::vector<Edge> edges;
   std::vector<std::int32_t> edge_faces;                // CSR payload of Edge::face_begin/count
   std::vector<std::array<std::int32_t, 3>> face_edges; // edge of (f[0],f[1]), (f[1],f[2]), (f[2],f[0])
+  std::vector<ShellInfo> shell_info;                   // indexed by shell_id
   MeshSummary summary;
   std::vector<Defect> defects;
 
   // False when any defect has Severity::error.
   bool usable() const;
+  // The defect with this code, or nullptr.
+  const Defect* find_defect(std::string_view code) const;
 };
 
 // Weld, repair, orient, find shells and surfaces. Fails only when nothing usable is left
