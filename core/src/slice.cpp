@@ -169,7 +169,7 @@ Slice slice_one(const Mesh& mesh, std::span<const std::int32_t> faces, double z,
       std::vector<OpenChain> pending = slice.open_chains;
       for (Loop& loop : detail::close_gaps(pending, params.gap_close_mm, slice.warnings)) {
         loops.push_back(std::move(loop));
-        loop_shell.push_back(-1);
+        loop_shell.push_back(-1 - static_cast<int>(loop_shell.size()));  // each its own body
       }
     } else {
       slice.warnings.push_back(fmt::format("z={:.4f} mm: {} open chain(s) left open (gap rule disabled)",
@@ -180,11 +180,19 @@ Slice slice_one(const Mesh& mesh, std::span<const std::int32_t> faces, double z,
   for (Loop& loop : loops) detail::compute_area(loop);
   detail::compute_nesting(loops);
   if (detail::needs_union(loops, loop_shell)) {
-    loops = detail::union_of_loops(loops);
-    for (Loop& loop : loops) detail::compute_area(loop);
-    detail::compute_nesting(loops);
-    slice.warnings.push_back(
-        fmt::format("z={:.4f} mm: overlapping shells, contours replaced by their union", z));
+    // Loops of different shells meet. Where they only touch the union is the loops themselves;
+    // report (and use) it only when it differs.
+    std::vector<Loop> merged = detail::union_of_loops(loops);
+    for (Loop& loop : merged) detail::compute_area(loop);
+    double before = 0.0, after = 0.0;
+    for (const Loop& l : loops) before += l.area_mm2;
+    for (const Loop& l : merged) after += l.area_mm2;
+    if (merged.size() != loops.size() || std::abs(after - before) > 1e-12 * std::max(1.0, std::abs(before))) {
+      detail::compute_nesting(merged);
+      loops = std::move(merged);
+      slice.warnings.push_back(
+          fmt::format("z={:.4f} mm: overlapping shells, contours replaced by their union", z));
+    }
   }
   slice.loops = std::move(loops);
   return slice;

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <set>
 
 namespace lamina::detail {
 namespace {
@@ -38,26 +39,46 @@ std::vector<Seg> segments_of(const std::vector<Loop>& loops) {
   return segs;
 }
 
-// Sweep in x over segments sorted by xmin; `visit` is called for every properly crossing pair of
-// segments from loops for which `pair_ok(loop_a, loop_b)` holds. Returns early when visit says so.
+// Sweep in x over segments sorted by xmin; `visit(o, cur, hit)` is called for every pair of
+// segments from different loops that meet (crossing, or touching at an end point; collinear
+// overlaps are left alone) and for which `pair_ok(loop_a, loop_b)` holds. It returns false to stop.
+struct Hit {
+  Eigen::Vector2d point;  // exact: an end point when one lies on the other segment
+  double t_o, t_cur;      // parameters along o and cur (0 or 1 at their own end points)
+};
+
 template <class PairOk, class Visit>
-void for_each_crossing(const std::vector<Seg>& segs, PairOk pair_ok, Visit visit) {
+void for_each_intersection(const std::vector<Seg>& segs, PairOk pair_ok, Visit visit) {
   std::vector<std::size_t> active;
   for (std::size_t s = 0; s < segs.size(); ++s) {
     const Seg& cur = segs[s];
     std::size_t w = 0;
+    bool stop = false;
     for (std::size_t k = 0; k < active.size(); ++k) {
       const Seg& o = segs[active[k]];
       if (o.xmax < cur.xmin) continue;  // left behind by the sweep
       active[w++] = active[k];
-      if (o.loop == cur.loop || o.ymax < cur.ymin || o.ymin > cur.ymax || !pair_ok(o.loop, cur.loop)) continue;
+      if (stop || o.loop == cur.loop || o.ymax < cur.ymin || o.ymin > cur.ymax || !pair_ok(o.loop, cur.loop)) continue;
       const double o1 = orient(cur.a, cur.b, o.a), o2 = orient(cur.a, cur.b, o.b);
       const double o3 = orient(o.a, o.b, cur.a), o4 = orient(o.a, o.b, cur.b);
-      if (((o1 > 0 && o2 < 0) || (o1 < 0 && o2 > 0)) && ((o3 > 0 && o4 < 0) || (o3 < 0 && o4 > 0))) {
-        if (!visit(o, cur, o1 / (o1 - o2), o3 / (o3 - o4))) return;
-      }
+      if ((o1 > 0 && o2 > 0) || (o1 < 0 && o2 < 0) || (o3 > 0 && o4 > 0) || (o3 < 0 && o4 < 0)) continue;
+      if (o1 == 0 && o2 == 0) continue;  // collinear
+      Hit h;
+      h.t_o = o1 / (o1 - o2);
+      h.t_cur = o3 / (o3 - o4);
+      if (o1 == 0) h.point = o.a, h.t_o = 0;
+      else if (o2 == 0) h.point = o.b, h.t_o = 1;
+      else if (o3 == 0) h.point = cur.a, h.t_cur = 0;
+      else if (o4 == 0) h.point = cur.b, h.t_cur = 1;
+      else h.point = o.a + h.t_o * (o.b - o.a);
+      if (h.point == cur.a) h.t_cur = 0;
+      if (h.point == cur.b) h.t_cur = 1;
+      if (h.point == o.a) h.t_o = 0;
+      if (h.point == o.b) h.t_o = 1;
+      stop = !visit(o, cur, h);
     }
     active.resize(w);
+    if (stop) return;
     active.push_back(s);
   }
 }
@@ -70,27 +91,28 @@ bool needs_union(const std::vector<Loop>& loops, const std::vector<int>& loop_sh
   bool several_shells = false;
   for (std::size_t i = 1; i < loop_shell.size(); ++i) several_shells |= loop_shell[i] != loop_shell[0];
   if (!several_shells) return false;
-  bool crossing = false;
-  for_each_crossing(
+  bool meet = false;
+  for_each_intersection(
       segments_of(loops), [&](std::size_t a, std::size_t b) { return loop_shell[a] != loop_shell[b]; },
-      [&](const Seg&, const Seg&, double, double) {
-        crossing = true;
+      [&](const Seg&, const Seg&, const Hit&) {
+        meet = true;
         return false;
       });
-  return crossing;
+  return meet;
 }
 
 std::vector<Loop> union_of_loops(const std::vector<Loop>& loops) {
   // 1. Split points per (loop, vector): parameter along the vector and the shared point.
   std::vector<std::vector<std::vector<std::pair<double, Eigen::Vector2d>>>> splits(loops.size());
+  std::set<std::pair<double, double>> junctions;  // every meeting point, split or not
   for (std::size_t l = 0; l < loops.size(); ++l) splits[l].resize(loops[l].points.size());
-  for_each_crossing(
+  for_each_intersection(
       segments_of(loops), [](std::size_t, std::size_t) { return true; },
-      [&](const Seg& o, const Seg& cur, double t_cur, double t_o) {
+      [&](const Seg& o, const Seg& cur, const Hit& h) {
         // One point for both pieces, so chaining by exact equality works.
-        const Eigen::Vector2d p = cur.a + t_cur * (cur.b - cur.a);
-        splits[cur.loop][cur.index].emplace_back(t_cur, p);
-        splits[o.loop][o.index].emplace_back(t_o, p);
+        junctions.emplace(h.point.x(), h.point.y());
+        if (h.t_cur > 0 && h.t_cur < 1) splits[cur.loop][cur.index].emplace_back(h.t_cur, h.point);
+        if (h.t_o > 0 && h.t_o < 1) splits[o.loop][o.index].emplace_back(h.t_o, h.point);
         return true;
       });
 
@@ -98,25 +120,28 @@ std::vector<Loop> union_of_loops(const std::vector<Loop>& loops) {
   struct Piece {
     Eigen::Vector2d a, b;
     std::int32_t facet;
+    std::size_t loop;
   };
   std::vector<Piece> kept;
   for (std::size_t l = 0; l < loops.size(); ++l) {
     const Loop& loop = loops[l];
     const int own_right = loop.area_mm2 > 0.0 ? 0 : -1;
     std::vector<Piece> pieces;
-    std::vector<std::size_t> run_start{0};
+    std::vector<std::size_t> run_start{0};  // a run is a stretch between meeting points
     const std::size_t n = loop.points.size();
     for (std::size_t i = 0; i < n; ++i) {
       auto& sp = splits[l][i];
       std::sort(sp.begin(), sp.end(), [](const auto& p, const auto& q) { return p.first < q.first; });
       Eigen::Vector2d from = loop.points[i];
       for (const auto& [t, p] : sp) {
-        pieces.push_back({from, p, loop.facets[i]});
-        run_start.push_back(pieces.size());
+        if (p == from) continue;
+        pieces.push_back({from, p, loop.facets[i], l});
         from = p;
       }
-      pieces.push_back({from, loop.points[(i + 1) % n], loop.facets[i]});
+      if (from != loop.points[(i + 1) % n]) pieces.push_back({from, loop.points[(i + 1) % n], loop.facets[i], l});
     }
+    for (std::size_t k = 1; k < pieces.size(); ++k)
+      if (junctions.count({pieces[k].a.x(), pieces[k].a.y()})) run_start.push_back(k);
     run_start.push_back(pieces.size());
     for (std::size_t r = 0; r + 1 < run_start.size(); ++r) {
       if (run_start[r] == run_start[r + 1]) continue;
@@ -153,12 +178,10 @@ std::vector<Loop> union_of_loops(const std::vector<Loop>& loops) {
         break;
       }
       auto [lo, hi] = by_start.equal_range(key(kept[cur].b));
+      // Where loops only touch, several pieces start here: stay on the same loop.
       std::size_t nxt = kept.size();
       for (auto it = lo; it != hi; ++it)
-        if (!used[it->second]) {
-          nxt = it->second;
-          break;
-        }
+        if (!used[it->second] && (nxt == kept.size() || kept[it->second].loop == kept[cur].loop)) nxt = it->second;
       if (nxt == kept.size()) break;
       cur = nxt;
     }
