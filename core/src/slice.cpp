@@ -20,31 +20,67 @@ namespace lamina {
 namespace {
 
 struct Segment {
+  Eigen::Vector2d start;    // the crossing point on start_edge
   std::int32_t start_edge;  // the facet's winding goes from above to below the plane here
   std::int32_t end_edge;    // ... and from below to above here
   std::int32_t face;
 };
 
-// Per-thread tables indexed by mesh edge; reset after each slice by touching only used entries.
+// Small open-addressing map from mesh edge to the first segment starting (or ending) there; a
+// slice has a few thousand segments, so this stays in cache where a table over all edges would not.
+class EdgeMap {
+ public:
+  void reset(std::size_t n) {
+    std::size_t cap = 16;
+    while (cap < 2 * n) cap <<= 1;
+    keys_.assign(cap, -1);
+    vals_.resize(cap);
+    mask_ = cap - 1;
+  }
+  // Returns the slot's value, inserting `v` when the key is new (then `inserted` is true).
+  std::int32_t& slot(std::int32_t key, bool& inserted) {
+    std::size_t i = hash(key);
+    while (keys_[i] != -1 && keys_[i] != key) i = (i + 1) & mask_;
+    inserted = keys_[i] == -1;
+    keys_[i] = key;
+    return vals_[i];
+  }
+  std::int32_t find(std::int32_t key) const {
+    for (std::size_t i = hash(key);; i = (i + 1) & mask_) {
+      if (keys_[i] == key) return vals_[i];
+      if (keys_[i] == -1) return -1;
+    }
+  }
+
+ private:
+  std::size_t hash(std::int32_t key) const {
+    return (static_cast<std::uint32_t>(key) * 2654435761u) & mask_;
+  }
+  std::vector<std::int32_t> keys_, vals_;
+  std::size_t mask_ = 0;
+};
+
 struct Scratch {
-  std::vector<std::int32_t> start_head;  // first segment starting at an edge, -1 if none
-  std::vector<std::int32_t> ends_at;     // number of segments ending at an edge
+  EdgeMap starts;  // edge → first segment starting there (others via next_same_start)
+  EdgeMap ends;    // edge → a segment ending there
   std::vector<std::int32_t> next_same_start;
   std::vector<Segment> segments;
   std::vector<char> used;
 };
 
-// The crossing point of the plane with mesh edge e, computed from the edge's canonical vertex
-// order so that both facets sharing the edge get identical coordinates.
-Eigen::Vector2d edge_point(const Mesh& mesh, std::int32_t e, double z) {
-  const Edge& edge = mesh.edges[static_cast<std::size_t>(e)];
-  const Eigen::Vector3d& p0 = mesh.vertices[static_cast<std::size_t>(edge.v0)];
-  const Eigen::Vector3d& p1 = mesh.vertices[static_cast<std::size_t>(edge.v1)];
-  // The vertex on or above the plane may lie exactly on it: then the point is that vertex.
+// The crossing point of the plane with the edge p0-p1, always evaluated from the edge's lower
+// vertex index so both facets sharing the edge get identical coordinates. The vertex on or above
+// the plane may lie exactly on it: then the point is that vertex.
+Eigen::Vector2d crossing(const Eigen::Vector3d& p0, const Eigen::Vector3d& p1, double z) {
   if (p0.z() == z) return p0.head<2>();
   if (p1.z() == z) return p1.head<2>();
   const double t = (z - p0.z()) / (p1.z() - p0.z());
   return p0.head<2>() + t * (p1.head<2>() - p0.head<2>());
+}
+
+Eigen::Vector2d edge_point(const Mesh& mesh, std::int32_t e, double z) {
+  const Edge& edge = mesh.edges[static_cast<std::size_t>(e)];
+  return crossing(mesh.vertices[static_cast<std::size_t>(edge.v0)], mesh.vertices[static_cast<std::size_t>(edge.v1)], z);
 }
 
 void collect_segments(const Mesh& mesh, std::span<const std::int32_t> faces, double z,
@@ -52,16 +88,24 @@ void collect_segments(const Mesh& mesh, std::span<const std::int32_t> faces, dou
   out.clear();
   for (const std::int32_t f : faces) {
     const auto& tri = mesh.faces[static_cast<std::size_t>(f)];
-    const auto& fe = mesh.face_edges[static_cast<std::size_t>(f)];
+    const Eigen::Vector3d* v[3];
     bool above[3];
-    for (int k = 0; k < 3; ++k) above[k] = mesh.vertices[static_cast<std::size_t>(tri[k])].z() >= z;
-    std::int32_t start = -1, end = -1;
+    for (int k = 0; k < 3; ++k) {
+      v[k] = &mesh.vertices[static_cast<std::size_t>(tri[k])];
+      above[k] = v[k]->z() >= z;
+    }
+    int start = -1, end = -1;
     for (int k = 0; k < 3; ++k) {
       const bool a = above[k], b = above[(k + 1) % 3];
-      if (a && !b) start = fe[k];
-      if (!a && b) end = fe[k];
+      if (a && !b) start = k;
+      if (!a && b) end = k;
     }
-    if (start >= 0 && end >= 0) out.push_back({start, end, f});
+    if (start < 0 || end < 0) continue;
+    const int k1 = (start + 1) % 3;
+    const bool lower_first = tri[start] < tri[k1];  // the edge's canonical order, as edge_point uses
+    const Eigen::Vector2d p = lower_first ? crossing(*v[start], *v[k1], z) : crossing(*v[k1], *v[start], z);
+    const auto& fe = mesh.face_edges[static_cast<std::size_t>(f)];
+    out.push_back({p, fe[start], fe[end], f});
   }
 }
 
@@ -69,8 +113,7 @@ void collect_segments(const Mesh& mesh, std::span<const std::int32_t> faces, dou
 // there: prefer one of the same shell, so touching bodies stay separate loops.
 std::int32_t next_segment(const Mesh& mesh, const Scratch& s, std::int32_t edge, std::int32_t shell) {
   std::int32_t fallback = -1;
-  for (std::int32_t c = s.start_head[static_cast<std::size_t>(edge)]; c >= 0;
-       c = s.next_same_start[static_cast<std::size_t>(c)]) {
+  for (std::int32_t c = s.starts.find(edge); c >= 0; c = s.next_same_start[static_cast<std::size_t>(c)]) {
     if (s.used[static_cast<std::size_t>(c)]) continue;
     const auto face = static_cast<std::size_t>(s.segments[static_cast<std::size_t>(c)].face);
     if (mesh.shell_id[face] == shell) return c;
@@ -105,12 +148,15 @@ Slice slice_one(const Mesh& mesh, std::span<const std::int32_t> faces, double z,
   const auto n = static_cast<std::int32_t>(s.segments.size());
   s.next_same_start.assign(static_cast<std::size_t>(n), -1);
   s.used.assign(static_cast<std::size_t>(n), 0);
+  s.starts.reset(static_cast<std::size_t>(n));
+  s.ends.reset(static_cast<std::size_t>(n));
   for (std::int32_t i = n - 1; i >= 0; --i) {  // reverse, so lists come out in segment order
     const Segment& seg = s.segments[static_cast<std::size_t>(i)];
-    auto& head = s.start_head[static_cast<std::size_t>(seg.start_edge)];
-    s.next_same_start[static_cast<std::size_t>(i)] = head;
+    bool inserted = false;
+    std::int32_t& head = s.starts.slot(seg.start_edge, inserted);
+    s.next_same_start[static_cast<std::size_t>(i)] = inserted ? -1 : head;
     head = i;
-    ++s.ends_at[static_cast<std::size_t>(seg.end_edge)];
+    s.ends.slot(seg.end_edge, inserted) = i;
   }
 
   std::vector<Loop> loops;
@@ -124,7 +170,7 @@ Slice slice_one(const Mesh& mesh, std::span<const std::int32_t> faces, double z,
     for (;;) {
       s.used[static_cast<std::size_t>(cur)] = 1;
       const Segment& seg = s.segments[static_cast<std::size_t>(cur)];
-      loop.points.push_back(edge_point(mesh, seg.start_edge, z));
+      loop.points.push_back(seg.start);
       loop.facets.push_back(seg.face);
       if (seg.end_edge == head.start_edge) {  // back where we started
         closed = true;
@@ -154,15 +200,10 @@ Slice slice_one(const Mesh& mesh, std::span<const std::int32_t> faces, double z,
   // Open chains first, from segments nothing leads into, so each is traced from its true start.
   for (std::int32_t i = 0; i < n; ++i) {
     if (s.used[static_cast<std::size_t>(i)]) continue;
-    if (s.ends_at[static_cast<std::size_t>(s.segments[static_cast<std::size_t>(i)].start_edge)] == 0) trace(i);
+    if (s.ends.find(s.segments[static_cast<std::size_t>(i)].start_edge) < 0) trace(i);
   }
   for (std::int32_t i = 0; i < n; ++i)
     if (!s.used[static_cast<std::size_t>(i)]) trace(i);
-
-  for (const Segment& seg : s.segments) {  // reset the per-edge tables for the next slice
-    s.start_head[static_cast<std::size_t>(seg.start_edge)] = -1;
-    s.ends_at[static_cast<std::size_t>(seg.end_edge)] = 0;
-  }
 
   if (!slice.open_chains.empty()) {
     if (params.gap_close_mm > 0.0) {
@@ -255,38 +296,13 @@ std::expected<std::vector<Slice>, Error> slice_mesh(const Mesh& mesh, std::span<
   std::vector<double> sorted_z(zs.size());
   for (std::size_t i = 0; i < order.size(); ++i) sorted_z[i] = zs[order[i]];
 
-  const std::size_t nf = mesh.faces.size();
-  std::vector<std::uint32_t> first(nf), last(nf);  // plane range [first, last) per facet
-  std::vector<std::int32_t> offsets(sorted_z.size() + 1, 0);
-  for (std::size_t f = 0; f < nf; ++f) {
-    const auto& t = mesh.faces[f];
-    const double z0 = mesh.vertices[static_cast<std::size_t>(t[0])].z();
-    const double z1 = mesh.vertices[static_cast<std::size_t>(t[1])].z();
-    const double z2 = mesh.vertices[static_cast<std::size_t>(t[2])].z();
-    const double lo = std::min({z0, z1, z2}), hi = std::max({z0, z1, z2});
-    first[f] = static_cast<std::uint32_t>(std::upper_bound(sorted_z.begin(), sorted_z.end(), lo) - sorted_z.begin());
-    last[f] = static_cast<std::uint32_t>(std::upper_bound(sorted_z.begin(), sorted_z.end(), hi) - sorted_z.begin());
-    for (std::uint32_t k = first[f]; k < last[f]; ++k) ++offsets[k + 1];
-  }
-  std::partial_sum(offsets.begin(), offsets.end(), offsets.begin());
-  std::vector<std::int32_t> bucket(static_cast<std::size_t>(offsets.back()));
-  {
-    std::vector<std::int32_t> fill(offsets.begin(), offsets.end() - 1);
-    for (std::size_t f = 0; f < nf; ++f)
-      for (std::uint32_t k = first[f]; k < last[f]; ++k) bucket[static_cast<std::size_t>(fill[k]++)] = static_cast<std::int32_t>(f);
-  }
-  first = {};
-  last = {};
+  const detail::FacetBuckets buckets = detail::bucket_facets(mesh, sorted_z);
 
   std::vector<Slice> out(zs.size());
-  tbb::enumerable_thread_specific<Scratch> scratch([&] {
-    Scratch s;
-    s.start_head.assign(mesh.edges.size(), -1);
-    s.ends_at.assign(mesh.edges.size(), 0);
-    return s;
-  });
+  tbb::enumerable_thread_specific<Scratch> scratch;
   auto run = [&](std::size_t k) {
-    std::span<const std::int32_t> faces(bucket.data() + offsets[k], bucket.data() + offsets[k + 1]);
+    std::span<const std::int32_t> faces(buckets.faces.data() + buckets.offsets[k],
+                                        buckets.faces.data() + buckets.offsets[k + 1]);
     out[order[k]] = slice_one(mesh, faces, sorted_z[k], params, scratch.local());
   };
   if (params.parallel) {

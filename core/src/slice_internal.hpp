@@ -2,9 +2,18 @@
 // Internal steps of slice_mesh, each in its own file; not part of the public API.
 #include "lamina/core/slice.hpp"
 
+#include <span>
 #include <vector>
 
 namespace lamina::detail {
+
+// The facets each plane cuts: plane p's are faces[offsets[p] .. offsets[p + 1]), ascending.
+struct FacetBuckets {
+  std::vector<std::int64_t> offsets;
+  std::vector<std::int32_t> faces;
+};
+// `sorted_z` must be ascending. Runs in parallel (TBB); the result does not depend on it.
+FacetBuckets bucket_facets(const Mesh& mesh, std::span<const double> sorted_z);
 
 // Join open chains whose ends lie within gap_mm (greedy, nearest first) into loops whose joining
 // vectors carry facet -1. Chains that cannot be closed stay in `chains` (they are reported).

@@ -78,6 +78,11 @@ Eigen::Vector2d probe_point(const Loop& l) {
 
 void compute_nesting(std::vector<Loop>& loops) {
   const std::size_t n = loops.size();
+  if (n == 1) {
+    loops[0].parent = -1;
+    loops[0].depth = 0;
+    return;
+  }
   std::vector<Box> boxes(n);
   std::vector<Eigen::Vector2d> probes(n);
   for (std::size_t i = 0; i < n; ++i) {
