@@ -1,7 +1,7 @@
 // read_mesh_file: opens the file, picks the parser from the extension (.obj, .3mf) or the
-// content (STL, binary or ASCII), and reads it. Binary STL is converted in 1 MiB chunks as it is
-// read (no copy of the whole file: that costs as much as the conversion); everything else is read
-// whole with one read() loop and parsed in memory.
+// content (STL binary or ASCII; failing that OBJ, or a 3MF zip under another name), and reads it.
+// Binary STL is converted in 1 MiB chunks as it is read (no copy of the whole file: that costs as
+// much as the conversion); everything else is read whole with one read() loop and parsed in memory.
 #include "lamina/core/mesh_io.hpp"
 #include "mesh_io_text.hpp"
 #include "stl_detail.hpp"
@@ -146,9 +146,11 @@ bool looks_like_obj(std::string_view text) {
 // Content that is not STL: say what it is when we can tell.
 std::expected<TriangleSoup, Error> not_stl(const Bytes& all, Error stl_error, const std::string& name) {
   const std::string_view text = all.text();
-  if (text.starts_with("PK\x03\x04")) {
+  if (text.starts_with("PK\x03\x04")) {  // a zip: perhaps a 3MF under another name
+    auto three_mf = parse_3mf(all.span(), name);
+    if (three_mf || three_mf.error().code != ErrorCode::unknown_format) return three_mf;
     return std::unexpected(Error{ErrorCode::unknown_format,
-                                 fmt::format("{}: a zip archive (a 3MF file? name it .3mf), not STL or OBJ", name)});
+                                 fmt::format("{} (a zip archive, but not STL, OBJ or 3MF)", three_mf.error().message)});
   }
   if (text.starts_with("ply\n") || text.starts_with("ply\r\n")) {
     return std::unexpected(Error{ErrorCode::unknown_format,
@@ -168,13 +170,10 @@ std::expected<TriangleSoup, Error> read_mesh_file(const std::filesystem::path& p
   if (!file) return std::unexpected(std::move(file.error()));
   const std::string ext = lower_extension(path);
 
-  if (ext == ".3mf") {
-    return std::unexpected(Error{ErrorCode::unsupported, fmt::format("{}: 3MF is not supported yet", name)});
-  }
-  if (ext == ".obj") {
+  if (ext == ".obj" || ext == ".3mf") {
     auto all = read_whole(*file, {});
     if (!all) return std::unexpected(std::move(all.error()));
-    return parse_obj(all->text(), name);
+    return ext == ".obj" ? parse_obj(all->text(), name) : parse_3mf(all->span(), name);
   }
 
   // STL by content: the first chunk and the size tell binary from ASCII.

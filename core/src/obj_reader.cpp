@@ -67,10 +67,14 @@ std::expected<TriangleSoup, Error> parse_obj(std::string_view text, std::string_
   const char* p = text.data();
   const char* const text_end = text.data() + text.size();
   if (text.starts_with("\xEF\xBB\xBF")) p += 3;
+  // Lines end with LF (or CRLF: the CR is whitespace); a file without any LF but with CRs uses
+  // classic Mac CR line ends.
+  const std::string_view body(p, static_cast<std::size_t>(text_end - p));
+  const char eol_char = body.find('\n') == std::string_view::npos && body.find('\r') != std::string_view::npos ? '\r' : '\n';
   std::size_t line = 0;
   while (p < text_end) {
     ++line;
-    const char* eol = static_cast<const char*>(std::memchr(p, '\n', static_cast<std::size_t>(text_end - p)));
+    const char* eol = static_cast<const char*>(std::memchr(p, eol_char, static_cast<std::size_t>(text_end - p)));
     if (eol == nullptr) eol = text_end;
     const char* line_end = eol;
     if (const void* hash = std::memchr(p, '#', static_cast<std::size_t>(line_end - p)))

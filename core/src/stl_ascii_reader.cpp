@@ -51,6 +51,26 @@ class Scanner {
     return {begin, static_cast<std::size_t>(last - begin)};
   }
 
+  // The name after "solid": the rest of the line, but stopping before a "facet" or "endsolid"
+  // token, so that a whole STL written on one line still parses.
+  std::string_view solid_name() {
+    while (p_ < end_ && *p_ != '\n' && is_space(*p_)) ++p_;
+    const char* begin = p_;
+    const char* last = p_;
+    while (p_ < end_ && *p_ != '\n') {
+      const char* tok = p_;
+      while (p_ < end_ && !is_space(*p_)) ++p_;
+      const std::string_view word(tok, static_cast<std::size_t>(p_ - tok));
+      if (iequals(word, "facet") || iequals(word, "endsolid")) {
+        p_ = tok;
+        break;
+      }
+      last = p_;
+      while (p_ < end_ && *p_ != '\n' && is_space(*p_)) ++p_;
+    }
+    return {begin, static_cast<std::size_t>(last - begin)};
+  }
+
   // Expects the keyword `lower` (case-insensitive).
   bool expect(std::string_view lower, Error& error) {
     std::string_view tok = next_token();
@@ -129,7 +149,7 @@ std::expected<TriangleSoup, Error> parse_stl_ascii(std::string_view text, std::s
     if (std::string_view tok = in.next_token(); !iequals(tok, "solid")) {
       return std::unexpected(in.unexpected_token(tok, solids.empty() ? "'solid'" : "'solid' or end of file"));
     }
-    Solid solid{std::string(in.rest_of_line()), 0};
+    Solid solid{std::string(in.solid_name()), 0};
 
     for (;;) {
       std::string_view tok = in.next_token();

@@ -51,6 +51,94 @@ inline std::vector<std::byte> binary_stl(std::span<const StlFacet> facets, std::
   return out;
 }
 
+// CRC-32 (zip, IEEE 802.3), bit by bit: slow and obviously right.
+inline std::uint32_t crc32(std::string_view data) {
+  std::uint32_t crc = 0xffffffffu;
+  for (char ch : data) {
+    crc ^= static_cast<unsigned char>(ch);
+    for (int k = 0; k < 8; ++k) crc = (crc >> 1) ^ (0xedb88320u & (0u - (crc & 1u)));
+  }
+  return ~crc;
+}
+
+// One zip entry: `data` is the content (method 0) or its raw deflate stream (method 8, with the
+// content's crc and size given).
+struct ZipItem {
+  std::string name;
+  std::string data;
+  std::uint16_t method = 0;
+  std::uint32_t crc = 0;
+  std::uint32_t size = 0;
+};
+
+inline ZipItem stored(std::string name, std::string content) {
+  const std::uint32_t crc = crc32(content);
+  const auto size = static_cast<std::uint32_t>(content.size());
+  return {std::move(name), std::move(content), 0, crc, size};
+}
+
+inline void put_u16_le(std::vector<std::byte>& out, std::uint32_t v) {
+  out.push_back(static_cast<std::byte>(v & 0xffu));
+  out.push_back(static_cast<std::byte>((v >> 8) & 0xffu));
+}
+
+// A plain zip archive (local headers, data, central directory, end record).
+inline std::vector<std::byte> make_zip(const std::vector<ZipItem>& items) {
+  std::vector<std::byte> out;
+  std::vector<std::uint32_t> offsets;
+  const auto put_text = [&out](std::string_view s) {
+    for (char c : s) out.push_back(static_cast<std::byte>(c));
+  };
+  for (const ZipItem& it : items) {
+    offsets.push_back(static_cast<std::uint32_t>(out.size()));
+    put_u32_le(out, 0x04034b50u);
+    put_u16_le(out, 20);  // version needed
+    put_u16_le(out, 0);   // flags
+    put_u16_le(out, it.method);
+    put_u16_le(out, 0);  // time
+    put_u16_le(out, 0);  // date
+    put_u32_le(out, it.crc);
+    put_u32_le(out, static_cast<std::uint32_t>(it.data.size()));
+    put_u32_le(out, it.size);
+    put_u16_le(out, static_cast<std::uint32_t>(it.name.size()));
+    put_u16_le(out, 0);  // extra
+    put_text(it.name);
+    put_text(it.data);
+  }
+  const auto cd_offset = static_cast<std::uint32_t>(out.size());
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    const ZipItem& it = items[i];
+    put_u32_le(out, 0x02014b50u);
+    put_u16_le(out, 20);  // made by
+    put_u16_le(out, 20);  // needed
+    put_u16_le(out, 0);   // flags
+    put_u16_le(out, it.method);
+    put_u16_le(out, 0);
+    put_u16_le(out, 0);
+    put_u32_le(out, it.crc);
+    put_u32_le(out, static_cast<std::uint32_t>(it.data.size()));
+    put_u32_le(out, it.size);
+    put_u16_le(out, static_cast<std::uint32_t>(it.name.size()));
+    put_u16_le(out, 0);  // extra
+    put_u16_le(out, 0);  // comment
+    put_u16_le(out, 0);  // disk
+    put_u16_le(out, 0);  // internal attributes
+    put_u32_le(out, 0);  // external attributes
+    put_u32_le(out, offsets[i]);
+    put_text(it.name);
+  }
+  const auto cd_size = static_cast<std::uint32_t>(out.size() - cd_offset);
+  put_u32_le(out, 0x06054b50u);
+  put_u16_le(out, 0);
+  put_u16_le(out, 0);
+  put_u16_le(out, static_cast<std::uint32_t>(items.size()));
+  put_u16_le(out, static_cast<std::uint32_t>(items.size()));
+  put_u32_le(out, cd_size);
+  put_u32_le(out, cd_offset);
+  put_u16_le(out, 0);  // comment
+  return out;
+}
+
 inline std::span<const std::byte> as_bytes(std::string_view s) {
   return {reinterpret_cast<const std::byte*>(s.data()), s.size()};
 }

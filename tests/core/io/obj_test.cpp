@@ -45,6 +45,16 @@ TEST(Obj, ReadsTrianglesWithEveryCornerFormAndSkipsOtherStatements) {
   EXPECT_TRUE(soup->notes.empty()) << soup->notes.front().code;
 }
 
+TEST(Obj, CrOnlyLineEndsAreLineEnds) {
+  auto soup = parse_obj("v 0 0 0\rv 1 0 0\rv 0 1 0\rv 0 0 1\rf 1 2 3\rf 1 3 4 # c\rx bad line\r", "mac.obj");
+  ASSERT_TRUE(soup) << soup.error().message;
+  ASSERT_EQ(soup->triangle_count(), 2u);
+  EXPECT_EQ(soup->corners[5], Eigen::Vector3f(0, 0, 1));
+  const ReadNote* note = find_note(*soup, "unknown_statements");
+  ASSERT_NE(note, nullptr);
+  EXPECT_NE(note->message.find("on line 7"), std::string::npos) << note->message;
+}
+
 TEST(Obj, NegativeIndicesAreRelativeToVerticesReadSoFar) {
   const std::string text =
       "v 0 0 0\nv 1 0 0\nv 0 1 0\n"

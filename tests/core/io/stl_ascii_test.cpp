@@ -67,6 +67,26 @@ TEST(StlAscii, ToleratesCrlfTabsCaseAndMissingFinalNewline) {
   EXPECT_EQ(soup->corners[2], Eigen::Vector3f(0, 1, 0));
 }
 
+TEST(StlAscii, WholeFileOnOneLine) {
+  auto soup = parse_text(
+      "solid one line facet normal 0 0 1 outer loop vertex 0 0 0 vertex 2 0 0 vertex 0 3 0 endloop endfacet "
+      "facet normal 0 0 1 outer loop vertex 1 1 1 vertex 2 1 1 vertex 1 2 1 endloop endfacet endsolid one line");
+  ASSERT_TRUE(soup) << soup.error().message;
+  ASSERT_EQ(soup->triangle_count(), 2u);
+  EXPECT_EQ(soup->corners[2], Eigen::Vector3f(0, 3, 0));
+  EXPECT_EQ(soup->corners[5], Eigen::Vector3f(1, 2, 1));
+  EXPECT_TRUE(soup->notes.empty());
+
+  // The name stops at "facet" / "endsolid" only as whole words.
+  auto named = parse_text("solid facets and endsolids\nfacet normal 0 0 1 outer loop vertex 0 0 0 vertex 1 0 0 "
+                          "vertex 0 1 0 endloop endfacet endsolid\nsolid b endsolid\n");
+  ASSERT_TRUE(named) << named.error().message;
+  EXPECT_EQ(named->triangle_count(), 1u);
+  const ReadNote* note = find_note(*named, "multiple_solids");
+  ASSERT_NE(note, nullptr);
+  EXPECT_NE(note->message.find("'facets and endsolids' 1 facets, 'b' 0 facets"), std::string::npos) << note->message;
+}
+
 TEST(StlAscii, SeveralSolidBlocksAreConcatenatedAndNoted) {
   std::string text(kTwoFacets);
   text += "solid second\nfacet normal 0 0 -1 outer loop vertex 0 0 9 vertex 0 1 9 vertex 1 0 9 endloop endfacet\n"

@@ -18,6 +18,10 @@ std::expected<TriangleSoup, Error> parse_stl(std::span<const std::byte> bytes, s
 // Parse Wavefront OBJ text; polygons are triangulated (ear clipping in their best-fit plane).
 std::expected<TriangleSoup, Error> parse_obj(std::string_view text, std::string_view name);
 
+// Parse a 3MF package (zip) held in memory: every build item's triangles, transformed. Needs zlib
+// at build time; without it the result is Error unsupported.
+std::expected<TriangleSoup, Error> parse_3mf(std::span<const std::byte> bytes, std::string_view name);
+
 // Read a mesh file; the format comes from the content (STL) or the extension (.obj, .3mf).
 std::expected<TriangleSoup, Error> read_mesh_file(const std::filesystem::path& path);
 
