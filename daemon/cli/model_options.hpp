@@ -7,7 +7,7 @@ namespace lamina::cli {
 
 // The options every model-reading command shares.
 inline void add_model_options(CLI::App& cmd, ModelOptions& o) {
-  cmd.add_option("MODEL", o.path, "Mesh file: STL (binary or ASCII) or OBJ")->required();
+  cmd.add_option("MODEL", o.path, "Mesh file: STL (binary or ASCII), OBJ or 3MF")->required();
   cmd.add_option("--units", o.units, "Units of the file")->check(CLI::IsMember({"mm", "in"}))->capture_default_str();
   cmd.add_option("--axis", o.axis, "Build direction (becomes +Z)")->check(CLI::IsMember({"x", "y", "z"}))->capture_default_str();
   cmd.add_option("--sharp-angle", o.sharp_angle_deg, "Dihedral angle (degrees) above which an edge bounds a surface")
