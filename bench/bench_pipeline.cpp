@@ -15,21 +15,24 @@
 
 namespace {
 
-const std::filesystem::path& sphere_file() {
-  static const std::filesystem::path path = [] {
-    auto p = std::filesystem::temp_directory_path() / ("lamina-bench-sphere-" + std::to_string(::getpid()) + ".stl");
-    lamina::test::write_binary_stl(lamina::test::uv_sphere(50.0, 1000, 501), p);
-    return p;
-  }();
-  return path;
-}
-
-struct RemoveSphereAtExit {
-  ~RemoveSphereAtExit() {
+// The sphere's temporary STL, written on first use and removed at exit (one object owns both).
+struct SphereFile {
+  std::filesystem::path path;
+  ~SphereFile() {
     std::error_code ec;
-    std::filesystem::remove(sphere_file(), ec);
+    if (!path.empty()) std::filesystem::remove(path, ec);
   }
-} remove_at_exit;
+} sphere;
+
+const std::filesystem::path& sphere_file() {
+  if (sphere.path.empty()) {
+    const auto p = std::filesystem::temp_directory_path() /
+                   ("lamina-bench-sphere-" + std::to_string(::getpid()) + ".stl");
+    lamina::test::write_binary_stl(lamina::test::uv_sphere(50.0, 1000, 501), p);
+    sphere.path = p;
+  }
+  return sphere.path;
+}
 
 void BM_Read(benchmark::State& state) {
   for (auto _ : state) {
