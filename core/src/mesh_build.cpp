@@ -41,7 +41,7 @@ const Defect* Mesh::find_defect(std::string_view code) const {
 
 namespace mesh_detail {
 
-void reserve_big(void* data, std::size_t bytes) {
+void hint_huge_pages(void* data, std::size_t bytes) {
 #if defined(__linux__) && defined(MADV_HUGEPAGE)
   constexpr std::uintptr_t huge = std::uintptr_t{2} << 20;
   if (bytes < 4 * huge) return;
@@ -144,6 +144,7 @@ std::expected<Mesh, Error> build_mesh(const TriangleSoup& soup, const MeshParams
   // Step 3: facets on welded vertices; drop degenerate ones; number vertices by first use.
   Mesh m;
   const double area_min = w.tolerance * w.tolerance * params.degenerate_area_factor;
+  const double cross2_min = 4.0 * area_min * area_min;  // |(b − a) × (c − a)|² = (2·area)²
   std::size_t degenerate = 0;
   Eigen::Vector3d first_degenerate = Eigen::Vector3d::Zero();
   {
@@ -160,8 +161,8 @@ std::expected<Mesh, Error> build_mesh(const TriangleSoup& soup, const MeshParams
       const Eigen::Vector3d& c = w.points[static_cast<std::size_t>(t[2])];
       bool bad = t[0] == t[1] || t[1] == t[2] || t[0] == t[2];
       if (!bad) {
-        const double area = 0.5 * (b - a).cross(c - a).norm();
-        bad = !(area > 0.0) || area < area_min;
+        const double cross2 = (b - a).cross(c - a).squaredNorm();
+        bad = !(cross2 > 0.0) || cross2 < cross2_min;
       }
       if (bad) {
         if (degenerate == 0) first_degenerate = (a + b + c) / 3.0;

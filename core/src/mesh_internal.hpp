@@ -35,16 +35,10 @@ namespace lamina::mesh_detail {
 
 using Tri = std::array<std::int32_t, 3>;
 
-// Allocate room for n elements and, for big arrays on Linux, ask for transparent huge pages
-// before the memory is first touched: first touch of fresh 4 KiB pages (a page fault each) is
-// a large part of building a million-facet mesh. Only a hint; behaviour is unchanged.
-void reserve_big(void* data, std::size_t bytes);
-template <class T>
-void reserve_hinted(std::vector<T>& v, std::size_t n) {
-  if (v.capacity() >= n) return;
-  v.reserve(n);
-  reserve_big(v.data(), n * sizeof(T));
-}
+// Ask for transparent huge pages on [data, data + bytes) before it is first touched (Linux;
+// a no-op elsewhere). Only for big tables read at random, where TLB misses would cost as much as
+// the accesses; not for arrays read in order (first touch of huge pages costs more up front).
+void hint_huge_pages(void* data, std::size_t bytes);
 
 inline std::uint64_t mix64(std::uint64_t h) {
   h ^= h >> 33;
@@ -61,23 +55,11 @@ inline std::size_t pow2_at_least(std::size_t n) {
   return c;
 }
 
-// mesh_weld_exact.cpp -------------------------------------------------------------------------
-
-struct ExactWeld {
-  std::vector<std::array<std::uint32_t, 3>> keys;  // float bit patterns, in order of first appearance
-  std::vector<std::int32_t> corner_point;          // per soup corner: index into keys, -1 if dropped
-  std::size_t nan_facets = 0;
-  std::size_t first_nan_facet = 0;
-};
-
-// Drop facets with a non-finite coordinate; merge bit-identical corners.
-ExactWeld exact_weld(const TriangleSoup& soup);
-
 // mesh_weld.cpp -------------------------------------------------------------------------------
 
 struct WeldResult {
-  // Points after the exact weld, in the build frame (rotated, scaled, not yet translated), in
-  // order of first appearance in the soup.
+  // The distinct points (exact weld), in the build frame (rotated, scaled, not yet translated),
+  // in order of first appearance in the soup.
   std::vector<Eigen::Vector3d> points;
   // Per point: the point it was welded to by the tolerance weld (the lowest index of its cluster;
   // itself when nothing was merged).
@@ -88,25 +70,25 @@ struct WeldResult {
   std::size_t nan_facets = 0;
   std::size_t first_nan_facet = 0;
 
-  Eigen::Vector3d bbox_min = Eigen::Vector3d::Zero(), bbox_max = Eigen::Vector3d::Zero();
   double tolerance = 0.0;  // absolute weld tolerance (mm)
 
   std::size_t tolerance_merged = 0;  // points merged only by the tolerance weld
   Eigen::Vector3d first_merged = Eigen::Vector3d::Zero();
 };
 
-// Frame transform, drop non-finite facets, exact weld, tolerance weld.
+// Drop non-finite facets, exact and tolerance weld, build frame.
 WeldResult weld_soup(const TriangleSoup& soup, const MeshParams& params);
 
-// The build-frame rotation (a cyclic permutation, det +1) applied to one file point.
-Eigen::Vector3d to_build_frame(const Eigen::Vector3f& p, BuildAxis axis, double scale);
+// The build-frame rotation (a cyclic permutation, det +1) and scale applied to a file point.
+Eigen::Vector3d to_build_frame(const Eigen::Vector3d& p, BuildAxis axis, double scale);
 
 // mesh_topology.cpp ---------------------------------------------------------------------------
 
 // What build_edges leaves beside the Mesh arrays for the later steps.
 struct Adjacency {
-  // Per facet side (3·f + k, side k from f[k] to f[k+1]): the facet across it when the edge is
-  // manifold, else -1. Facet ids do not change when a facet is turned over, so it stays valid.
+  // Per facet side (3·f + k, side k from f[k] to f[k+1]): when the edge is manifold,
+  // 2·g + same, g the facet across it and same = 1 when both facets run along the edge in the
+  // same direction (as wound when the table was built); else -1.
   std::vector<std::int32_t> across;
   // Edges with face_count != 2 (boundary or non-manifold), increasing.
   std::vector<std::int32_t> odd_edges;
@@ -118,13 +100,6 @@ struct Adjacency {
 // Flat arrays only: no map, no per-edge allocation.
 Adjacency build_edges(std::size_t vertex_count, const std::vector<Tri>& faces, std::vector<Edge>& edges,
                       std::vector<std::int32_t>& edge_faces, std::vector<Tri>& face_edges);
-
-// The other facet of a manifold edge.
-inline std::int32_t other_face(const Mesh& m, std::int32_t e, std::int32_t f) {
-  const Edge& ed = m.edges[static_cast<std::size_t>(e)];
-  const std::int32_t a = m.edge_faces[static_cast<std::size_t>(ed.face_begin)];
-  return a == f ? m.edge_faces[static_cast<std::size_t>(ed.face_begin) + 1] : a;
-}
 
 // Local index (0..2) of edge e in facet f.
 inline int local_edge(const Mesh& m, std::int32_t f, std::int32_t e) {
@@ -178,6 +153,14 @@ struct ShellFaces {
   std::vector<std::int32_t> begin;
 };
 
+struct Box3 {
+  Eigen::Vector3d lo, hi;
+  bool contains(const Box3& o, double slack) const {
+    return (lo.array() - slack <= o.lo.array()).all() && (o.hi.array() <= hi.array() + slack).all();
+  }
+  bool contains(const Eigen::Vector3d& p) const { return (lo.array() <= p.array()).all() && (p.array() <= hi.array()).all(); }
+};
+
 // mesh_shells.cpp -----------------------------------------------------------------------------
 
 // Per shell: closedness, signed volume, nesting depth among closed shells (ray parity); turns
@@ -185,6 +168,13 @@ struct ShellFaces {
 // Fills shell_info.
 void outward_shells(Mesh& m, const Adjacency& adj, const ShellFaces& sf, const std::vector<char>& shell_conflict,
                     OrientResult& r);
+
+// mesh_nesting.cpp ----------------------------------------------------------------------------
+
+// For each shell in `closed` (closed shells of non-zero volume): how many of the others enclose
+// it (box inside box, larger volume, three probe points inside by ray parity). Other entries 0.
+std::vector<int> nesting_depths(const Mesh& m, const ShellFaces& sf, const std::vector<std::size_t>& closed,
+                                const std::vector<Box3>& box, const std::vector<double>& vol);
 
 // mesh_surfaces.cpp ---------------------------------------------------------------------------
 

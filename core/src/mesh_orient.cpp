@@ -19,12 +19,8 @@
 namespace lamina::mesh_detail {
 namespace {
 
-// True when facets f and g run along their shared edge (side k of f) in the same direction.
-inline bool same_direction(const Tri& f, int k, const Tri& g) {
-  const std::int32_t a = f[static_cast<std::size_t>(k)], b = f[static_cast<std::size_t>((k + 1) % 3)];
-  // Bitwise, not short-circuit: the outcome is data-dependent and branches would mispredict.
-  return ((g[0] == a) & (g[1] == b)) | ((g[1] == a) & (g[2] == b)) | ((g[2] == a) & (g[0] == b));
-}
+// Per-facet walk state, one byte each so the whole table stays in cache.
+constexpr std::uint8_t kVisited = 1, kFlip = 2, kSurfaced = 4;
 
 }  // namespace
 
@@ -33,7 +29,7 @@ OrientResult orient_shells(Mesh& m, const Adjacency& adj, double sharp_angle_rad
   const std::size_t nf = m.faces.size();
   m.shell_id.assign(nf, -1);
   m.surface_id.assign(nf, -1);
-  std::vector<char> flip(nf, 0);
+  std::vector<std::uint8_t> state(nf, 0);
   // Joined when the angle between normals is <= the threshold, i.e. cos(angle) >= cos(threshold).
   // 1e-6 rad of slack: corners come from float32 files, so a dihedral angle that is exactly the
   // threshold by design (a 12-gon's 30°) is off by ~1e-7 rad either way and must still join.
@@ -42,59 +38,75 @@ OrientResult orient_shells(Mesh& m, const Adjacency& adj, double sharp_angle_rad
   ShellFaces sf;
   sf.order.reserve(nf);
   std::vector<char> shell_conflict;
-  std::vector<std::int32_t> smooth, pending;  // facets to expand now / seeds of later surfaces
-  std::size_t conflicts_twice = 0;
+  // sf.order doubles as the breadth-first queue of the current surface (a facet enters it once,
+  // when its surface is known); pending holds facets reached across sharp edges.
+  std::vector<std::int32_t> pending;
+  std::size_t head = 0, conflicts_twice = 0;
   std::int32_t surfaces = 0;
 
   for (std::size_t seed = 0; seed < nf; ++seed) {
-    if (m.shell_id[seed] >= 0) continue;
+    if (state[seed] & kVisited) continue;
     const auto s = static_cast<std::int32_t>(sf.begin.size());
     sf.begin.push_back(static_cast<std::int32_t>(sf.order.size()));
     shell_conflict.push_back(0);
+    state[seed] = kVisited;
     m.shell_id[seed] = s;
     pending.push_back(static_cast<std::int32_t>(seed));
     while (!pending.empty()) {
       const std::int32_t f0 = pending.back();
       pending.pop_back();
-      if (m.surface_id[static_cast<std::size_t>(f0)] >= 0) continue;
+      if (state[static_cast<std::size_t>(f0)] & kSurfaced) continue;
       const std::int32_t sid = surfaces++;
+      state[static_cast<std::size_t>(f0)] |= kSurfaced;
       m.surface_id[static_cast<std::size_t>(f0)] = sid;
-      smooth.push_back(f0);
-      while (!smooth.empty()) {
-        const std::int32_t f = smooth.back();
-        smooth.pop_back();
-        sf.order.push_back(f);
-        const auto fu = static_cast<std::size_t>(f);
-        const Tri& tf = m.faces[fu];
-        for (int k = 0; k < 3; ++k) {
-          const std::int32_t g = adj.across[3 * fu + static_cast<std::size_t>(k)];
-          if (g < 0) continue;
-          const auto gu = static_cast<std::size_t>(g);
+      sf.order.push_back(f0);
+      while (head < sf.order.size()) {
+        // Prefetch two stages ahead along the queue: the across entries of a facet 16 places
+        // on, and the normals of the neighbours of the facet 8 places on (normals are the
+        // one large array the walk reads at random).
+        if (head + 16 < sf.order.size())
+          __builtin_prefetch(&adj.across[3 * static_cast<std::size_t>(sf.order[head + 16])]);
+        if (head + 8 < sf.order.size()) {
+          const std::int32_t* ahead = &adj.across[3 * static_cast<std::size_t>(sf.order[head + 8])];
+          for (int k = 0; k < 3; ++k)
+            if (ahead[k] >= 0) __builtin_prefetch(&m.normals[static_cast<std::size_t>(ahead[k] >> 1)]);
+        }
+        const auto fu = static_cast<std::size_t>(sf.order[head++]);
+        const std::uint8_t flip_f = state[fu] & kFlip;
+        const Eigen::Vector3d nf_ = m.normals[fu];
+        for (std::size_t k = 0; k < 3; ++k) {
+          const std::int32_t a = adj.across[3 * fu + k];
+          if (a < 0) continue;
+          const auto gu = static_cast<std::size_t>(a >> 1);
           // g must be turned over when, after f's own turn, both run the same way.
-          const char want = static_cast<char>(flip[fu] ^ (same_direction(tf, k, m.faces[gu]) ? 1 : 0));
+          const std::uint8_t want = flip_f ^ ((a & 1) ? kFlip : 0);
+          std::uint8_t sg = state[gu];
           bool fresh = false;
-          if (m.shell_id[gu] < 0) {
+          if (!(sg & kVisited)) {
+            sg = static_cast<std::uint8_t>(kVisited | want);
             m.shell_id[gu] = s;
-            flip[gu] = want;
             fresh = true;
-          } else if (flip[gu] != want) {
+          } else if ((sg & kFlip) != want) {
             // Seen once from each side: a non-orientable shell (a Möbius-like strip).
             if (conflicts_twice == 0) {
-              const Edge& ed = m.edges[static_cast<std::size_t>(m.face_edges[fu][static_cast<std::size_t>(k)])];
+              const Edge& ed = m.edges[static_cast<std::size_t>(m.face_edges[fu][k])];
               r.first_conflict = 0.5 * (m.vertices[static_cast<std::size_t>(ed.v0)] +
                                         m.vertices[static_cast<std::size_t>(ed.v1)]);
             }
             ++conflicts_twice;
             shell_conflict[static_cast<std::size_t>(s)] = 1;
           }
-          if (m.surface_id[gu] >= 0) continue;
-          const double d = m.normals[fu].dot(m.normals[gu]);
-          if ((flip[fu] == flip[gu] ? d : -d) >= min_cos) {
-            m.surface_id[gu] = sid;
-            smooth.push_back(g);
-          } else if (fresh) {
-            pending.push_back(g);
+          if (!(sg & kSurfaced)) {
+            const double d = nf_.dot(m.normals[gu]);
+            if ((flip_f == (sg & kFlip) ? d : -d) >= min_cos) {
+              sg |= kSurfaced;
+              m.surface_id[gu] = sid;
+              sf.order.push_back(static_cast<std::int32_t>(gu));
+            } else if (fresh) {
+              pending.push_back(static_cast<std::int32_t>(gu));
+            }
           }
+          state[gu] = sg;
         }
       }
     }
@@ -108,13 +120,13 @@ OrientResult orient_shells(Mesh& m, const Adjacency& adj, double sharp_angle_rad
   for (std::size_t s = 0; s < shells; ++s) {
     std::size_t flips = 0;
     const auto b = static_cast<std::size_t>(sf.begin[s]), e = static_cast<std::size_t>(sf.begin[s + 1]);
-    for (std::size_t i = b; i < e; ++i) flips += static_cast<std::size_t>(flip[static_cast<std::size_t>(sf.order[i])]);
+    for (std::size_t i = b; i < e; ++i) flips += (state[static_cast<std::size_t>(sf.order[i])] & kFlip) ? 1 : 0;
     if (2 * flips > e - b) {
-      for (std::size_t i = b; i < e; ++i) flip[static_cast<std::size_t>(sf.order[i])] ^= 1;
+      for (std::size_t i = b; i < e; ++i) state[static_cast<std::size_t>(sf.order[i])] ^= kFlip;
     }
   }
   for (std::size_t f = 0; f < nf; ++f) {
-    if (!flip[f]) continue;
+    if (!(state[f] & kFlip)) continue;
     if (r.facets_flipped == 0) r.first_flipped = centroid(m, f);
     flip_face(m, f);
     ++r.facets_flipped;

@@ -2,9 +2,7 @@
 //
 // A closed shell's signed volume says which way its (already consistent) facets face. A shell
 // nested inside an odd number of other closed shells is a cavity and must have negative volume;
-// every other shell must have positive volume. Nesting is decided by ray parity from points on
-// the shell against the candidate container's facets (three skew rays, majority vote), only for
-// containers whose box holds the shell's box and whose volume is larger. Open shells have no
+// every other shell must have positive volume (nesting: mesh_nesting.cpp). Open shells have no
 // inside; they are turned so that their volume about their box centre is positive, when that
 // volume is clearly non-zero.
 #include "mesh_internal.hpp"
@@ -20,61 +18,8 @@
 namespace lamina::mesh_detail {
 namespace {
 
-struct Box {
-  Eigen::Vector3d lo, hi;
-  bool contains(const Box& o, double slack) const {
-    return (lo.array() - slack <= o.lo.array()).all() && (o.hi.array() <= hi.array() + slack).all();
-  }
-  bool contains(const Eigen::Vector3d& p) const {
-    return (lo.array() <= p.array()).all() && (p.array() <= hi.array()).all();
-  }
-};
-
-// Möller–Trumbore: does the ray p + t·d, t > 0, cross triangle abc?
-bool ray_hits(const Eigen::Vector3d& p, const Eigen::Vector3d& d, const Eigen::Vector3d& a,
-              const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
-  const Eigen::Vector3d e1 = b - a, e2 = c - a;
-  const Eigen::Vector3d h = d.cross(e2);
-  const double det = e1.dot(h);
-  if (det == 0.0) return false;
-  const double inv = 1.0 / det;
-  const Eigen::Vector3d s = p - a;
-  const double u = s.dot(h) * inv;
-  if (u < 0.0 || u > 1.0) return false;
-  const Eigen::Vector3d q = s.cross(e1);
-  const double v = d.dot(q) * inv;
-  if (v < 0.0 || u + v > 1.0) return false;
-  return e2.dot(q) * inv > 0.0;
-}
-
-bool point_inside(const Mesh& m, const ShellFaces& sf, std::size_t shell, const Eigen::Vector3d& p) {
-  // Skew directions: rays through edges or vertices of axis-aligned CAD meshes are unlikely.
-  static const Eigen::Vector3d dirs[3] = {Eigen::Vector3d(0.2113249, 0.3471105, 0.9137).normalized(),
-                                          Eigen::Vector3d(-0.5773503, 0.1339746, -0.8053).normalized(),
-                                          Eigen::Vector3d(0.7071068, -0.6180340, 0.3435).normalized()};
-  int votes = 0;
-  for (const auto& d : dirs) {
-    int parity = 0;
-    for (auto i = sf.begin[shell]; i < sf.begin[shell + 1]; ++i) {
-      const Tri& t = m.faces[static_cast<std::size_t>(sf.order[static_cast<std::size_t>(i)])];
-      parity ^= ray_hits(p, d, m.vertices[static_cast<std::size_t>(t[0])], m.vertices[static_cast<std::size_t>(t[1])],
-                         m.vertices[static_cast<std::size_t>(t[2])])
-                    ? 1
-                    : 0;
-    }
-    votes += parity;
-  }
-  return votes >= 2;
-}
-
-double facet_area2(const Mesh& m, std::int32_t f) {
-  const Tri& t = m.faces[static_cast<std::size_t>(f)];
-  const Eigen::Vector3d& a = m.vertices[static_cast<std::size_t>(t[0])];
-  return (m.vertices[static_cast<std::size_t>(t[1])] - a).cross(m.vertices[static_cast<std::size_t>(t[2])] - a).squaredNorm();
-}
-
 struct Acc {
-  Box box{Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()),
+  Box3 box{Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()),
           Eigen::Vector3d::Constant(-std::numeric_limits<double>::infinity())};
   double six_v = 0.0;
   Eigen::Vector3d area2 = Eigen::Vector3d::Zero();
@@ -167,7 +112,7 @@ void outward_shells(Mesh& m, const Adjacency& adj, const ShellFaces& sf, const s
   // A2 = Σ (b−a)×(c−a), both about a reference point, 6V(c) = 6V(ref) − (c − ref)·A2.
   const Eigen::Vector3d ref = m.vertices[0];
   std::vector<Acc> acc = accumulate_shells(m, shells, ref);
-  std::vector<Box> box(shells);
+  std::vector<Box3> box(shells);
   std::vector<double> vol(shells);
   for (std::size_t s = 0; s < shells; ++s) {
     box[s] = acc[s].box;
@@ -179,33 +124,8 @@ void outward_shells(Mesh& m, const Adjacency& adj, const ShellFaces& sf, const s
   std::vector<std::size_t> closed_list;
   for (std::size_t s = 0; s < shells; ++s)
     if (closed[s] && vol[s] != 0.0) closed_list.push_back(s);
-  if (closed_list.size() >= 2) {
-    for (const std::size_t s : closed_list) {
-      const double slack = 1e-9 * (box[s].hi - box[s].lo).norm();
-      // Test points on the shell: its largest facet's centroid and two more spread over it.
-      const std::int32_t* fs = sf.order.data() + sf.begin[s];
-      const auto n = static_cast<std::size_t>(sf.begin[s + 1] - sf.begin[s]);
-      std::size_t big = 0;
-      double big_a = -1.0;
-      for (std::size_t i = 0; i < n; ++i) {
-        const double a = facet_area2(m, fs[i]);
-        if (a > big_a) big_a = a, big = i;
-      }
-      const Eigen::Vector3d probes[3] = {centroid(m, static_cast<std::size_t>(fs[big])), centroid(m, static_cast<std::size_t>(fs[n / 3])),
-                                         centroid(m, static_cast<std::size_t>(fs[(2 * n) / 3]))};
-      for (const std::size_t t : closed_list) {
-        if (t == s || std::abs(vol[t]) <= std::abs(vol[s]) || !box[t].contains(box[s], slack)) continue;
-        bool all_inside = true;
-        for (const auto& p : probes) {
-          if (!box[t].contains(p) || !point_inside(m, sf, t, p)) {
-            all_inside = false;
-            break;
-          }
-        }
-        if (all_inside) ++m.shell_info[s].depth;
-      }
-    }
-  }
+  const std::vector<int> depth = nesting_depths(m, sf, closed_list, box, vol);
+  for (std::size_t s = 0; s < shells; ++s) m.shell_info[s].depth = depth[s];
 
   // Turn over the shells that face the wrong way.
   for (std::size_t s = 0; s < shells; ++s) {

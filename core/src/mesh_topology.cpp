@@ -58,7 +58,6 @@ Adjacency build_edges(std::size_t vertex_count, const std::vector<Tri>& faces, s
   const std::size_t nf = faces.size();
   const std::size_t nv = vertex_count;
   Adjacency adj;
-  LAMINA_TIMER();
 
   // Counting sort of the sides on their lower vertex, in parallel over chunks of facets: each
   // chunk counts, the prefix sums give each chunk its place inside each bucket, each chunk
@@ -93,10 +92,8 @@ Adjacency build_edges(std::size_t vertex_count, const std::vector<Tri>& faces, s
     }
     start[nv] = run;
   }
-  LAMINA_TICK("e:count");
 
   // Scatter side ids into their buckets (edge_faces is the bucket storage for now).
-  reserve_hinted(edge_faces, nf * 3);
   edge_faces.resize(nf * 3);
   tbb::parallel_for(std::size_t{0}, chunks, [&](std::size_t t) {
     auto& at = fill[t];
@@ -107,7 +104,6 @@ Adjacency build_edges(std::size_t vertex_count, const std::vector<Tri>& faces, s
     }
   });
   fill = {};
-  LAMINA_TICK("e:scatter");
   // Sort each bucket by (higher vertex, side id) and count its distinct edges.
   std::vector<std::int32_t> edge_start(nv + 1, 0);
   tbb::enumerable_thread_specific<std::vector<Side>> scratch;
@@ -127,17 +123,12 @@ Adjacency build_edges(std::size_t vertex_count, const std::vector<Tri>& faces, s
     }
   });
   for (std::size_t v = 0; v < nv; ++v) edge_start[v + 1] += edge_start[v];
-  LAMINA_TICK("e:sort");
 
   // Emit edges, face_edges and the across table; side ids become facet ids.
   const auto ne = static_cast<std::size_t>(edge_start[nv]);
-  reserve_hinted(edges, ne);
-  reserve_hinted(face_edges, nf);
-  reserve_hinted(adj.across, nf * 3);
   edges.resize(ne);
   face_edges.resize(nf);
   adj.across.resize(nf * 3);
-  LAMINA_TICK("e:alloc");
   tbb::enumerable_thread_specific<std::vector<std::int32_t>> odd;
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nv, kGrain), [&](const tbb::blocked_range<std::size_t>& r) {
     auto& my_odd = odd.local();
@@ -152,8 +143,13 @@ Adjacency build_edges(std::size_t vertex_count, const std::vector<Tri>& faces, s
         const auto count = static_cast<std::int32_t>(j - i);
         edges[e] = Edge{static_cast<std::int32_t>(v), hi, static_cast<std::int32_t>(i), count};
         if (count == 2) {
-          adj.across[static_cast<std::size_t>(edge_faces[i])] = edge_faces[i + 1] / 3;
-          adj.across[static_cast<std::size_t>(edge_faces[i + 1])] = edge_faces[i] / 3;
+          const std::int32_t s0 = edge_faces[i], s1 = edge_faces[i + 1];
+          // A side runs "up" when it starts at this bucket's (lower) vertex v.
+          const bool up0 = faces[static_cast<std::size_t>(s0 / 3)][static_cast<std::size_t>(s0 % 3)] == static_cast<std::int32_t>(v);
+          const bool up1 = faces[static_cast<std::size_t>(s1 / 3)][static_cast<std::size_t>(s1 % 3)] == static_cast<std::int32_t>(v);
+          const std::int32_t same = up0 == up1 ? 1 : 0;
+          adj.across[static_cast<std::size_t>(s0)] = (s1 / 3) * 2 + same;
+          adj.across[static_cast<std::size_t>(s1)] = (s0 / 3) * 2 + same;
         } else {
           my_odd.push_back(static_cast<std::int32_t>(e));
           for (std::size_t s = i; s < j; ++s) adj.across[static_cast<std::size_t>(edge_faces[s])] = -1;
@@ -168,7 +164,6 @@ Adjacency build_edges(std::size_t vertex_count, const std::vector<Tri>& faces, s
       }
     }
   });
-  LAMINA_TICK("e:emit");
   for (const auto& v : odd) adj.odd_edges.insert(adj.odd_edges.end(), v.begin(), v.end());
   std::sort(adj.odd_edges.begin(), adj.odd_edges.end());
   return adj;

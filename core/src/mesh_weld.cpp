@@ -1,20 +1,45 @@
-// Step 1–2 of build_mesh: into the build frame, weld.
+// Steps 1–2 of build_mesh: drop non-finite facets, weld, put the points in the build frame.
 //
-// After the exact weld (mesh_weld_exact.cpp) only unique points are converted to double and
-// put in the build frame. The tolerance weld then runs once over those unique points with a hashed grid whose cells are much larger than the
-// tolerance: each point looks only into its own cell, plus a neighbour cell across a face it
-// lies within tolerance of, against the points inserted before it (so every close pair is
-// seen once, by its later point), and merges with union-find (the lowest index is the root).
+// One pass over the corners does both welds. Points are hashed by the cell of a grid whose
+// cells are much larger than the weld tolerance, into an open-addressing table whose slots hold
+// the point's bit pattern, so a corner repeating a known point (most corners) costs one memory
+// access, prefetched a few corners ahead.
+//  - exact weld: a corner bit-identical to a point already seen (+0 and -0 alike) is that point;
+//  - tolerance weld: a new point is compared with the points before it in its own cell and, only
+//    when it lies within tolerance of a cell face, in the neighbour cell(s) across that face
+//    (every close pair is seen once, by its later point); close points are merged with
+//    union-find, the lowest index (first appearance) being the representative.
+// The grid works in file units; only the distinct points are converted to the build frame.
 #include "mesh_internal.hpp"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_reduce.h>
+
 #include <algorithm>
-#include <bit>
 #include <cmath>
 #include <cstring>
 #include <limits>
 
 namespace lamina::mesh_detail {
 namespace {
+
+using Key = std::array<std::uint32_t, 3>;
+
+// The bit pattern of a corner, with -0 read as +0 (equal values, one vertex).
+inline Key key_of(const Eigen::Vector3f& c) {
+  const Eigen::Vector3f p = c.array() + 0.0f;
+  Key k;
+  std::memcpy(k.data(), p.data(), sizeof k);
+  return k;
+}
+
+// No NaN or infinite coordinate (exponent bits not all ones).
+inline bool finite(const Key& k) {
+  constexpr std::uint32_t exp = 0x7f800000u;
+  return ((k[0] & exp) != exp) & ((k[1] & exp) != exp) & ((k[2] & exp) != exp);
+}
+
+inline bool same(const Key& a, const Key& b) { return ((a[0] ^ b[0]) | (a[1] ^ b[1]) | (a[2] ^ b[2])) == 0; }
 
 inline std::uint64_t hash_cell(std::int64_t x, std::int64_t y, std::int64_t z) {
   std::uint64_t h = static_cast<std::uint64_t>(x) * 0x9E3779B97F4A7C15ULL;
@@ -23,14 +48,37 @@ inline std::uint64_t hash_cell(std::int64_t x, std::int64_t y, std::int64_t z) {
   return mix64(h);
 }
 
-// Lookahead of the software prefetch: the cell table is far larger than the caches.
-constexpr std::size_t kAhead = 16;
+constexpr std::size_t kAhead = 16;  // prefetch distance (corners)
+
+struct Grid {
+  Eigen::Vector3d lo;
+  double inv_cell = 1.0;
+  // Cell coordinates of p, and p's position inside the cell (0..1) per axis. p is inside the
+  // box, so q >= 0 and truncation is floor (std::floor is a library call on baseline x86-64).
+  std::array<std::int64_t, 3> cell(const Eigen::Vector3d& p, double frac[3]) const {
+    std::array<std::int64_t, 3> c;
+    for (int a = 0; a < 3; ++a) {
+      const double q = std::max(0.0, (p[a] - lo[a]) * inv_cell);
+      const auto i = static_cast<std::int64_t>(q);
+      frac[a] = q - static_cast<double>(i);
+      c[static_cast<std::size_t>(a)] = i;
+    }
+    return c;
+  }
+  std::uint64_t hash(const Eigen::Vector3d& p) const {
+    double frac[3];
+    const auto c = cell(p, frac);
+    return hash_cell(c[0], c[1], c[2]);
+  }
+};
+
+struct Slot {
+  Key k;            // the point's bit pattern: identity and position
+  std::int32_t id;  // -1: empty
+};
 
 struct UnionFind {
   std::vector<std::int32_t> parent;
-  explicit UnionFind(std::size_t n) : parent(n) {
-    for (std::size_t i = 0; i < n; ++i) parent[i] = static_cast<std::int32_t>(i);
-  }
   std::int32_t find(std::int32_t x) {
     while (parent[static_cast<std::size_t>(x)] != x) {
       auto& p = parent[static_cast<std::size_t>(x)];
@@ -48,97 +96,195 @@ struct UnionFind {
   }
 };
 
-// Tolerance weld of the (exactly unique) points; fills rep.
-void tolerance_weld(WeldResult& w) {
-  const std::size_t n = w.points.size();
-  w.rep.resize(n);
-  for (std::size_t i = 0; i < n; ++i) w.rep[i] = static_cast<std::int32_t>(i);
-  const double tol = w.tolerance;
-  if (!(tol > 0.0) || n < 2) return;
+struct Bounds {
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector3d hi = Eigen::Vector3d::Constant(-std::numeric_limits<double>::infinity());
+  std::size_t bad = 0;
+  std::size_t first_bad = std::numeric_limits<std::size_t>::max();
+};
 
-  const double diag = (w.bbox_max - w.bbox_min).norm();
-  // Cells far larger than the tolerance: a point is rarely near a cell face. The floor keeps
-  // cell indices well inside int64 for absurdly small tolerances.
-  const double cell = std::max(tol * 64.0, diag * 1e-12);
-  const double inv_cell = 1.0 / cell;
-  const double near = tol * inv_cell * (1.0 + 1e-9) + 1e-12;  // in cell units, conservative
+// Box of the finite facets' corners (file units) and the non-finite facets. Parallel; min, max,
+// count and first index do not depend on the split.
+Bounds scan(const TriangleSoup& soup) {
+  const std::size_t nf = soup.triangle_count();
+  return tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, nf, 1 << 15), Bounds{},
+      [&](const tbb::blocked_range<std::size_t>& r, Bounds b) {
+        // One accumulator per corner position: three independent min/max chains per facet.
+        Eigen::Vector3f lo[3], hi[3];
+        for (int k = 0; k < 3; ++k) lo[k] = b.lo.cast<float>(), hi[k] = b.hi.cast<float>();
+        for (std::size_t f = r.begin(); f != r.end(); ++f) {
+          const Eigen::Vector3f& p0 = soup.corners[3 * f];
+          const Eigen::Vector3f& p1 = soup.corners[3 * f + 1];
+          const Eigen::Vector3f& p2 = soup.corners[3 * f + 2];
+          if (!(finite(key_of(p0)) & finite(key_of(p1)) & finite(key_of(p2)))) {
+            b.first_bad = std::min(b.first_bad, f);
+            ++b.bad;
+            continue;
+          }
+          lo[0] = lo[0].cwiseMin(p0), lo[1] = lo[1].cwiseMin(p1), lo[2] = lo[2].cwiseMin(p2);
+          hi[0] = hi[0].cwiseMax(p0), hi[1] = hi[1].cwiseMax(p1), hi[2] = hi[2].cwiseMax(p2);
+        }
+        b.lo = lo[0].cwiseMin(lo[1]).cwiseMin(lo[2]).cast<double>();
+        b.hi = hi[0].cwiseMax(hi[1]).cwiseMax(hi[2]).cast<double>();
+        return b;
+      },
+      [](Bounds a, const Bounds& b) {
+        a.lo = a.lo.cwiseMin(b.lo);
+        a.hi = a.hi.cwiseMax(b.hi);
+        a.bad += b.bad;
+        a.first_bad = std::min(a.first_bad, b.first_bad);
+        return a;
+      });
+}
+
+}  // namespace
+
+Eigen::Vector3d to_build_frame(const Eigen::Vector3d& p, BuildAxis axis, double scale) {
+  switch (axis) {
+    case BuildAxis::x: return Eigen::Vector3d(p.y(), p.z(), p.x()) * scale;  // +X becomes +Z
+    case BuildAxis::y: return Eigen::Vector3d(p.z(), p.x(), p.y()) * scale;  // +Y becomes +Z
+    case BuildAxis::z: break;
+  }
+  return p * scale;
+}
+
+WeldResult weld_soup(const TriangleSoup& soup, const MeshParams& params) {
+  WeldResult w;
+  const std::size_t nf = soup.triangle_count();
+  const std::size_t nc = nf * 3;
+
+  const Bounds bounds = scan(soup);
+  w.nan_facets = bounds.bad;
+  w.first_nan_facet = bounds.bad > 0 ? bounds.first_bad : 0;
+  w.corner_point.resize(nc);
+  if (bounds.bad == nf) {
+    std::fill(w.corner_point.begin(), w.corner_point.end(), -1);
+    return w;
+  }
+
+  // The grid, in file units. Cells far larger than the tolerance, so a point is rarely near a
+  // face; the floor keeps cell indices well inside int64 for absurdly small tolerances.
+  const double diag = (bounds.hi - bounds.lo).norm();
+  const double tol = params.weld_tolerance_rel * diag;
   const double tol2 = tol * tol;
+  const bool tolerant = tol > 0.0;
+  Grid grid;
+  grid.lo = bounds.lo;
+  const double cell = diag > 0.0 ? std::max(tolerant ? tol * 64.0 : diag * 1e-5, diag * 1e-12) : 1.0;
+  grid.inv_cell = 1.0 / cell;
+  const double near = tolerant ? tol * grid.inv_cell * (1.0 + 1e-9) + 1e-12 : -1.0;  // in cell units
 
-  struct Slot {
-    std::uint32_t tag;  // upper bits of the cell hash; cells sharing a tag share a list (harmless)
-    std::int32_t head;  // -1: empty
-  };
-  const std::size_t cap = pow2_at_least(2 * n);
-  const std::size_t mask = cap - 1;
-  std::vector<Slot> table(cap, Slot{0, -1});
-  std::vector<std::int32_t> next(n, -1);
-  UnionFind uf(n);
+  std::vector<Key> keys;  // the distinct points, in order of first appearance
+  UnionFind uf;
+  const std::size_t guess = nc / 5 + 16;
+  keys.reserve(guess);
+  uf.parent.reserve(guess);
 
-  auto find_slot = [&](std::uint64_t key) -> std::size_t {
-    const auto tag = static_cast<std::uint32_t>(key >> 32);
-    std::size_t s = key & mask;
-    while (table[s].head >= 0 && table[s].tag != tag) s = (s + 1) & mask;
-    return s;
+  // Open addressing on the cell hash: a point sits in the probe run that starts at its cell's
+  // slot, so the points of one cell (and, rarely, of cells hashing nearby) are contiguous, and
+  // the bit pattern in the slot gives both identity and position. A closed mesh has about one
+  // point per six corners: start at load <= 0.5 for that and double past 0.5.
+  std::size_t cap = pow2_at_least(nc / 3 + 1);
+  std::size_t mask = cap - 1;
+  std::vector<Slot> table;
+  auto make_table = [&] {
+    table = {};
+    table.reserve(cap);
+    hint_huge_pages(table.data(), cap * sizeof(Slot));
+    table.assign(cap, Slot{{0, 0, 0}, -1});
   };
-  auto own_cell = [&](std::size_t i, double fr[3]) {
-    const Eigen::Vector3d q = (w.points[i] - w.bbox_min) * inv_cell;
-    std::array<std::int64_t, 3> c;
-    for (int a = 0; a < 3; ++a) {
-      const double fl = std::floor(q[a]);
-      fr[a] = q[a] - fl;
-      c[static_cast<std::size_t>(a)] = static_cast<std::int64_t>(fl);
+  make_table();
+  auto point_of = [](const Key& k) {
+    Eigen::Vector3f p;
+    std::memcpy(p.data(), k.data(), sizeof k);
+    return Eigen::Vector3d(p.cast<double>());
+  };
+  auto grow = [&] {
+    cap <<= 1;
+    mask = cap - 1;
+    make_table();
+    for (std::size_t i = 0; i < keys.size(); ++i) {
+      std::size_t s = grid.hash(point_of(keys[i])) & mask;
+      while (table[s].id >= 0) s = (s + 1) & mask;
+      table[s] = Slot{keys[i], static_cast<std::int32_t>(i)};
     }
-    return c;
   };
+  auto corner_hash = [&](std::size_t c) { return grid.hash(soup.corners[c].cast<double>()); };
 
+  bool facet_ok = true;
   std::uint64_t ring[kAhead];
-  for (std::size_t i = 0; i < std::min(n, kAhead); ++i) {
-    double fr[3];
-    const auto c = own_cell(i, fr);
-    ring[i] = hash_cell(c[0], c[1], c[2]);
-    __builtin_prefetch(&table[ring[i] & mask]);
-  }
-  for (std::size_t i = 0; i < n; ++i) {
-    const std::uint64_t own_key = ring[i % kAhead];
-    if (i + kAhead < n) {
-      double fr[3];
-      const auto c = own_cell(i + kAhead, fr);
-      ring[i % kAhead] = hash_cell(c[0], c[1], c[2]);
-      __builtin_prefetch(&table[ring[i % kAhead] & mask]);
+  for (std::size_t c = 0; c < std::min(nc, kAhead); ++c) ring[c] = corner_hash(c);
+  for (std::size_t c = 0; c < nc; ++c) {
+    const std::uint64_t h = ring[c % kAhead];
+    if (c + kAhead < nc) {
+      const std::uint64_t ha = corner_hash(c + kAhead);
+      ring[c % kAhead] = ha;
+      __builtin_prefetch(&table[ha & mask]);
     }
-    const Eigen::Vector3d& p = w.points[i];
-    double fr[3];
-    const auto c0 = own_cell(i, fr);
-    std::int64_t c[3][2];
-    int cn[3];
-    for (int a = 0; a < 3; ++a) {
-      c[a][0] = c0[static_cast<std::size_t>(a)];
-      cn[a] = 1;
-      if (fr[a] < near) {
-        c[a][cn[a]++] = c[a][0] - 1;
-      } else if (fr[a] > 1.0 - near) {
-        c[a][cn[a]++] = c[a][0] + 1;
+    if (c % 3 == 0)
+      facet_ok = finite(key_of(soup.corners[c])) && finite(key_of(soup.corners[c + 1])) &&
+                 finite(key_of(soup.corners[c + 2]));
+    if (!facet_ok) {
+      w.corner_point[c] = -1;
+      continue;
+    }
+    const Key k = key_of(soup.corners[c]);
+    std::size_t s = h & mask;
+    std::int32_t found = -1;
+    for (; table[s].id >= 0; s = (s + 1) & mask) {
+      if (same(table[s].k, k)) {
+        found = table[s].id;
+        break;
       }
     }
-    auto visit = [&](std::size_t s) {
-      for (std::int32_t j = table[s].head; j >= 0; j = next[static_cast<std::size_t>(j)]) {
-        if ((w.points[static_cast<std::size_t>(j)] - p).squaredNorm() <= tol2) uf.unite(static_cast<std::int32_t>(i), j);
-      }
-    };
-    const std::size_t own_slot = find_slot(own_key);
-    visit(own_slot);
-    if (cn[0] + cn[1] + cn[2] > 3) {
-      for (int ix = 0; ix < cn[0]; ++ix)
-        for (int iy = 0; iy < cn[1]; ++iy)
-          for (int iz = 0; iz < cn[2]; ++iz)
-            if (ix + iy + iz > 0) visit(find_slot(hash_cell(c[0][ix], c[1][iy], c[2][iz])));
+    if (found >= 0) {  // the common case: a point seen before
+      w.corner_point[c] = found;
+      continue;
     }
-    if (table[own_slot].head < 0) table[own_slot].tag = static_cast<std::uint32_t>(own_key >> 32);
-    next[i] = table[own_slot].head;
-    table[own_slot].head = static_cast<std::int32_t>(i);
-  }
 
+    // A new point (s is the free slot ending its run).
+    const auto i = static_cast<std::int32_t>(keys.size());
+    keys.push_back(k);
+    uf.parent.push_back(i);
+    if (tolerant) {
+      const Eigen::Vector3d p = soup.corners[c].cast<double>();
+      auto visit = [&](std::size_t t) {
+        for (; table[t].id >= 0; t = (t + 1) & mask)
+          if ((point_of(table[t].k) - p).squaredNorm() <= tol2) uf.unite(i, table[t].id);
+      };
+      visit(h & mask);
+      double frac[3];
+      const auto c0 = grid.cell(p, frac);
+      std::int64_t cs[3][2];
+      int cn[3];
+      for (int a = 0; a < 3; ++a) {
+        cs[a][0] = c0[static_cast<std::size_t>(a)];
+        cn[a] = 1;
+        if (frac[a] < near)
+          cs[a][cn[a]++] = cs[a][0] - 1;
+        else if (frac[a] > 1.0 - near)
+          cs[a][cn[a]++] = cs[a][0] + 1;
+      }
+      if (cn[0] + cn[1] + cn[2] > 3) {
+        for (int ix = 0; ix < cn[0]; ++ix)
+          for (int iy = 0; iy < cn[1]; ++iy)
+            for (int iz = 0; iz < cn[2]; ++iz)
+              if (ix + iy + iz > 0) visit(hash_cell(cs[0][ix], cs[1][iy], cs[2][iz]) & mask);
+      }
+    }
+    table[s] = Slot{k, i};
+    w.corner_point[c] = i;
+    if (keys.size() * 2 > cap) grow();
+  }
+  table = {};
+
+  // Representatives, the weld report, and the build frame.
+  const std::size_t n = keys.size();
+  w.rep.resize(n);
+  w.points.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
+    w.points[i] = to_build_frame(point_of(keys[i]), params.axis, params.scale_to_mm);
     const std::int32_t r = uf.find(static_cast<std::int32_t>(i));
     w.rep[i] = r;
     if (r != static_cast<std::int32_t>(i)) {
@@ -146,47 +292,7 @@ void tolerance_weld(WeldResult& w) {
       ++w.tolerance_merged;
     }
   }
-}
-
-}  // namespace
-
-Eigen::Vector3d to_build_frame(const Eigen::Vector3f& p, BuildAxis axis, double scale) {
-  const double x = p.x(), y = p.y(), z = p.z();
-  switch (axis) {
-    case BuildAxis::x: return Eigen::Vector3d(y, z, x) * scale;  // +X becomes +Z
-    case BuildAxis::y: return Eigen::Vector3d(z, x, y) * scale;  // +Y becomes +Z
-    case BuildAxis::z: break;
-  }
-  return Eigen::Vector3d(x, y, z) * scale;
-}
-
-WeldResult weld_soup(const TriangleSoup& soup, const MeshParams& params) {
-  WeldResult w;
-  LAMINA_TIMER();
-  ExactWeld ex = exact_weld(soup);
-  LAMINA_TICK("w:exact");
-  w.nan_facets = ex.nan_facets;
-  w.first_nan_facet = ex.first_nan_facet;
-  w.corner_point = std::move(ex.corner_point);
-
-  w.points.resize(ex.keys.size());
-  for (std::size_t i = 0; i < ex.keys.size(); ++i) {
-    Eigen::Vector3f p;
-    std::memcpy(p.data(), ex.keys[i].data(), sizeof ex.keys[i]);
-    w.points[i] = to_build_frame(p, params.axis, params.scale_to_mm);
-  }
-  ex.keys = {};
-  if (!w.points.empty()) {
-    w.bbox_min = w.bbox_max = w.points[0];
-    for (const auto& p : w.points) {
-      w.bbox_min = w.bbox_min.cwiseMin(p);
-      w.bbox_max = w.bbox_max.cwiseMax(p);
-    }
-  }
-  w.tolerance = params.weld_tolerance_rel * (w.bbox_max - w.bbox_min).norm();
-  LAMINA_TICK("w:frame");
-  tolerance_weld(w);
-  LAMINA_TICK("w:tolerance");
+  w.tolerance = tol * params.scale_to_mm;
   return w;
 }
 

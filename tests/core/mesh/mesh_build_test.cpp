@@ -175,7 +175,7 @@ TEST(BuildMesh, SameInputSameOutput) {
 }
 
 TEST(BuildMesh, ThreadCountDoesNotChangeTheResult) {
-  // Big enough (81408 facets) for the partitioned weld and the chunked edge sort to split.
+  // Big enough (81408 facets) for the chunked edge sort to split.
   const TriangleSoup s = mesh_test::append(mesh_test::perturbed(mesh_test::uv_sphere(30.0, 256, 160)),
                                            mesh_test::inverted(box({100, 0, 0}, {101, 1, 1})));
   Mesh serial, parallel;

@@ -173,6 +173,38 @@ TEST(MeshRepair, IslandInsideACavityIsASolidAgain) {
   EXPECT_EQ(defect_count(m, "inside_out"), 1u);
 }
 
+TEST(MeshRepair, ManyVoidsInABlockAreAllCavities) {
+  // A 20 mm block with 10 × 10 × 4 small cubic voids, all given wound outward (wrong).
+  TriangleSoup s = box({0, 0, 0}, {20, 20, 20});
+  for (int i = 0; i < 10; ++i)
+    for (int j = 0; j < 10; ++j)
+      for (int k = 0; k < 4; ++k) {
+        const Eigen::Vector3f lo(1.0f + 1.8f * static_cast<float>(i), 1.0f + 1.8f * static_cast<float>(j),
+                                 2.0f + 4.0f * static_cast<float>(k));
+        s = append(s, box(lo, lo + Eigen::Vector3f::Constant(0.5f)));
+      }
+  const Mesh m = build(s);
+  ASSERT_EQ(m.summary.shells, 401);
+  EXPECT_EQ(defect_count(m, "inside_out"), 400u);
+  EXPECT_NEAR(m.summary.volume_mm3, 8000.0 - 400 * 0.125, 1e-6);
+  for (int sh = 1; sh < 401; ++sh) {
+    EXPECT_EQ(m.shell_info[static_cast<std::size_t>(sh)].depth, 1);
+    EXPECT_LT(m.shell_info[static_cast<std::size_t>(sh)].volume_mm3, 0.0);
+  }
+  EXPECT_NE(m.find_defect("multiple_shells")->message.find("1 body, 400 cavities"), std::string::npos)
+      << m.find_defect("multiple_shells")->message;
+}
+
+TEST(MeshRepair, SphericalCavityInASphere) {
+  // Curved, finely faceted container: the cavity (given outward) is found inside it.
+  const TriangleSoup outer = mesh_test::uv_sphere(10.0, 64, 32), inner = mesh_test::uv_sphere(4.0, 32, 16, {1, 0, 0.5});
+  const Mesh m = build(append(outer, inner));
+  ASSERT_EQ(m.summary.shells, 2);
+  EXPECT_EQ(m.shell_info[1].depth, 1);
+  EXPECT_EQ(defect_count(m, "inside_out"), 1u);
+  EXPECT_NEAR(m.summary.volume_mm3, mesh_test::soup_volume(outer) - mesh_test::soup_volume(inner), 1e-6);
+}
+
 TEST(MeshRepair, OverlappingSolidsAreNotCavities) {
   // Two intersecting boxes, neither inside the other: both stay solids.
   const Mesh m = build(append(box({0, 0, 0}, {2, 2, 2}), box({1, 0.5f, 0.5f}, {3, 1.5f, 1.5f})));
