@@ -66,6 +66,26 @@ TEST(MeshRepair, CleanCubeReportsNoWeld) {
   EXPECT_EQ(build(unit_cube()).find_defect("welded_vertices"), nullptr);
 }
 
+TEST(MeshRepair, ToleranceComesFromTheWholeModelNotASample) {
+  // The tolerance is relative to the whole model's box. A lone far triangle (facet 1: a sampling
+  // shortcut taking every 2nd facet would miss it) makes the diagonal ~1700, so the tolerance
+  // (1e-7 × that) must weld the sphere's corners displaced by 1e-5, which a tolerance sized from
+  // the sphere alone (~3.5e-7) would not.
+  TriangleSoup sphere = mesh_test::uv_sphere(1.0, 128, 40);
+  for (std::size_t c = 1; c < sphere.corners.size(); c += 2) sphere.corners[c] += Eigen::Vector3f(1e-5f, -1e-5f, 1e-5f);
+  TriangleSoup s;
+  s.corners.assign(sphere.corners.begin(), sphere.corners.begin() + 3);
+  mesh_test::add_tri(s, {1000, 1000, 1000}, {1001, 1000, 1000}, {1000, 1001, 1000});  // facet 1
+  s.corners.insert(s.corners.end(), sphere.corners.begin() + 3, sphere.corners.end());
+  ASSERT_GE(s.triangle_count(), 8192u);
+  const Mesh m = build(s);
+  EXPECT_EQ(m.summary.boundary_edges, 3u);  // only the lone triangle's
+  EXPECT_EQ(m.summary.shells, 2);
+  EXPECT_TRUE(m.shell_info[0].closed);
+  EXPECT_GT(defect_count(m, "welded_vertices"), 0u);
+  EXPECT_EQ(m.summary.vertices, 2u + 128u * 39 + 3);
+}
+
 TEST(MeshRepair, MinusZeroIsZeroEvenForTheExactWeld) {
   TriangleSoup s = unit_cube();
   for (std::size_t c = 0; c < s.corners.size(); c += 2)
