@@ -294,12 +294,25 @@ std::expected<Mesh, Error> build_mesh(const TriangleSoup& soup, const MeshParams
                                         format_point(orient.first_inverted)),
                             orient.first_inverted));
   if (s.shells > 1) {
-    int cavities = 0;
-    for (const ShellInfo& sh : m.shell_info) cavities += sh.volume_mm3 < 0.0 ? 1 : 0;
+    std::size_t solids = 0, cavities = 0, open = 0;
+    for (const ShellInfo& sh : m.shell_info) {
+      if (!sh.closed)
+        ++open;
+      else if (sh.volume_mm3 < 0.0)
+        ++cavities;
+      else
+        ++solids;
+    }
+    std::string kinds;
+    auto add = [&](std::size_t n, const char* one, const char* many) {
+      if (n == 0) return;
+      kinds += fmt::format("{}{} {}", kinds.empty() ? "" : ", ", n, plural(n, one, many));
+    };
+    add(solids, "solid", "solids");
+    add(cavities, "cavity", "cavities");
+    add(open, "open", "open");
     d.push_back(make_defect("multiple_shells", Severity::info, static_cast<std::size_t>(s.shells),
-                            fmt::format("{} separate shells ({} {}, {} {})", s.shells, s.shells - cavities,
-                                        plural(static_cast<std::size_t>(s.shells - cavities), "body", "bodies"),
-                                        cavities, plural(static_cast<std::size_t>(cavities), "cavity", "cavities"))));
+                            fmt::format("{} separate shells ({})", s.shells, kinds)));
   }
   LAMINA_TICK("summary");
   return m;

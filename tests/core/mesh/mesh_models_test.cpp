@@ -137,6 +137,8 @@ TEST(MeshModels, TeapotIsOpen) {
   // them touch at a single vertex, so counted by shared vertices (as the README does) they are
   // 3 bodies.
   EXPECT_EQ(m.summary.shells, 4);
+  ASSERT_NE(m.find_defect("multiple_shells"), nullptr);
+  EXPECT_EQ(m.find_defect("multiple_shells")->message, "4 separate shells (4 open)");
   std::vector<int> parent(static_cast<std::size_t>(m.summary.shells));
   std::iota(parent.begin(), parent.end(), 0);
   auto find = [&](int x) {

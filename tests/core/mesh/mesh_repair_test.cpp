@@ -211,7 +211,7 @@ TEST(MeshRepair, ManyVoidsInABlockAreAllCavities) {
     EXPECT_EQ(m.shell_info[static_cast<std::size_t>(sh)].depth, 1);
     EXPECT_LT(m.shell_info[static_cast<std::size_t>(sh)].volume_mm3, 0.0);
   }
-  EXPECT_NE(m.find_defect("multiple_shells")->message.find("1 body, 400 cavities"), std::string::npos)
+  EXPECT_NE(m.find_defect("multiple_shells")->message.find("401 separate shells (1 solid, 400 cavities)"), std::string::npos)
       << m.find_defect("multiple_shells")->message;
 }
 
