@@ -120,6 +120,9 @@ std::optional<Error> check_params(const MeshParams& p) {
     case BuildAxis::z: break;
     default: return bad("build_mesh: unknown build axis");
   }
+  if (p.direction && !(p.direction->allFinite() && p.direction->norm() > 0.0))
+    return bad(fmt::format("build_mesh: the build direction ({}, {}, {}) must be finite and non-zero",
+                           p.direction->x(), p.direction->y(), p.direction->z()));
   return std::nullopt;
 }
 

@@ -80,7 +80,7 @@ struct WeldResult {
 WeldResult weld_soup(const TriangleSoup& soup, const MeshParams& params);
 
 // The build-frame rotation (a cyclic permutation, det +1) and scale applied to a file point.
-Eigen::Vector3d to_build_frame(const Eigen::Vector3d& p, BuildAxis axis, double scale);
+Eigen::Vector3d to_build_frame(const Eigen::Vector3d& p, const Eigen::Matrix3d& rotation, double scale);
 
 // mesh_topology.cpp ---------------------------------------------------------------------------
 

@@ -12,6 +12,8 @@
 // The grid works in file units; only the distinct points are converted to the build frame.
 #include "mesh_internal.hpp"
 
+#include <Eigen/Geometry>
+
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_reduce.h>
 
@@ -140,13 +142,31 @@ Bounds scan(const TriangleSoup& soup) {
 
 }  // namespace
 
-Eigen::Vector3d to_build_frame(const Eigen::Vector3d& p, BuildAxis axis, double scale) {
-  switch (axis) {
-    case BuildAxis::x: return Eigen::Vector3d(p.y(), p.z(), p.x()) * scale;  // +X becomes +Z
-    case BuildAxis::y: return Eigen::Vector3d(p.z(), p.x(), p.y()) * scale;  // +Y becomes +Z
+}  // namespace lamina::mesh_detail
+
+namespace lamina {
+
+Eigen::Matrix3d build_frame_rotation(const MeshParams& params) {
+  Eigen::Matrix3d r;
+  if (params.direction) {
+    r = Eigen::Quaterniond::FromTwoVectors(*params.direction, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    return r;
+  }
+  switch (params.axis) {
+    case BuildAxis::x: r << 0, 1, 0, 0, 0, 1, 1, 0, 0; return r;  // (x,y,z) → (y,z,x): +X becomes +Z
+    case BuildAxis::y: r << 0, 0, 1, 1, 0, 0, 0, 1, 0; return r;  // (x,y,z) → (z,x,y): +Y becomes +Z
     case BuildAxis::z: break;
   }
-  return p * scale;
+  return Eigen::Matrix3d::Identity();
+}
+
+}  // namespace lamina
+
+namespace lamina::mesh_detail {
+
+Eigen::Vector3d to_build_frame(const Eigen::Vector3d& p, const Eigen::Matrix3d& rotation, double scale) {
+  // Permutation matrices multiply exactly (0·a + 1·b + 0·c == b for finite values).
+  return (rotation * p) * scale;
 }
 
 WeldResult weld_soup(const TriangleSoup& soup, const MeshParams& params) {
@@ -283,8 +303,9 @@ WeldResult weld_soup(const TriangleSoup& soup, const MeshParams& params) {
   const std::size_t n = keys.size();
   w.rep.resize(n);
   w.points.resize(n);
+  const Eigen::Matrix3d rotation = build_frame_rotation(params);
   for (std::size_t i = 0; i < n; ++i) {
-    w.points[i] = to_build_frame(point_of(keys[i]), params.axis, params.scale_to_mm);
+    w.points[i] = to_build_frame(point_of(keys[i]), rotation, params.scale_to_mm);
     const std::int32_t r = uf.find(static_cast<std::int32_t>(i));
     w.rep[i] = r;
     if (r != static_cast<std::int32_t>(i)) {

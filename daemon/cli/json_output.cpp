@@ -35,7 +35,8 @@ nlohmann::json mesh_json(const LoadedModel& model) {
 
 void write_slice_report(std::FILE* out, const ModelOptions& options, const LoadedModel& model,
                         std::span<const Slice> slices, const nlohmann::json& timing) {
-  const nlohmann::json head{{"file", options.path}, {"units", options.units}, {"axis", options.axis}};
+  nlohmann::json head{{"file", options.path}, {"units", options.units}, {"axis", options.axis}};
+  if (!options.direction.empty()) head["direction"] = options.direction;
   fmt::print(out, "{{\"model\":{},\n\"mesh\":{},\n\"slices\":[", head.dump(), mesh_json(model).dump());
   for (std::size_t si = 0; si < slices.size(); ++si) {
     const Slice& sl = slices[si];

@@ -16,6 +16,7 @@ MeshParams mesh_params_from(const ModelOptions& o) {
   MeshParams p;
   p.scale_to_mm = o.units == "in" ? 25.4 : 1.0;
   p.axis = o.axis == "x" ? BuildAxis::x : o.axis == "y" ? BuildAxis::y : BuildAxis::z;
+  if (o.direction.size() == 3) p.direction = Eigen::Vector3d(o.direction[0], o.direction[1], o.direction[2]);
   p.sharp_angle_rad = o.sharp_angle_deg * std::numbers::pi / 180.0;
   p.weld_tolerance_rel = o.weld_tolerance_rel;
   return p;

@@ -4,6 +4,7 @@
 
 #include <expected>
 #include <string>
+#include <vector>
 
 namespace lamina::cli {
 
@@ -11,6 +12,7 @@ struct ModelOptions {
   std::string path;
   std::string units = "mm";  // mm | in — converted here, once; everything inside is mm
   std::string axis = "z";    // x | y | z — the build direction
+  std::vector<double> direction;  // or any vector (3 numbers); replaces axis when given
   double sharp_angle_deg = 30.0;
   double weld_tolerance_rel = 1e-7;
 };

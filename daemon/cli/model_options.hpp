@@ -9,7 +9,13 @@ namespace lamina::cli {
 inline void add_model_options(CLI::App& cmd, ModelOptions& o) {
   cmd.add_option("MODEL", o.path, "Mesh file: STL (binary or ASCII), OBJ or 3MF")->required();
   cmd.add_option("--units", o.units, "Units of the file")->check(CLI::IsMember({"mm", "in"}))->capture_default_str();
-  cmd.add_option("--axis", o.axis, "Build direction (becomes +Z)")->check(CLI::IsMember({"x", "y", "z"}))->capture_default_str();
+  auto* axis = cmd.add_option("--axis", o.axis, "Build direction (becomes +Z)")
+                   ->check(CLI::IsMember({"x", "y", "z"}))
+                   ->capture_default_str();
+  cmd.add_option("--direction", o.direction, "Any build direction X,Y,Z instead of --axis")
+      ->delimiter(',')
+      ->expected(3)
+      ->excludes(axis);
   cmd.add_option("--sharp-angle", o.sharp_angle_deg, "Dihedral angle (degrees) above which an edge bounds a surface")
       ->check(CLI::Range(0.0, 180.0))
       ->capture_default_str();

@@ -20,6 +20,9 @@ enum class BuildAxis { x, y, z };
 struct MeshParams {
   // The model's build direction becomes +Z (a proper rotation, so winding is kept).
   BuildAxis axis = BuildAxis::z;
+  // Any build direction (need not be unit); when set it replaces `axis`. The rotation used is the
+  // smallest one taking it to +Z.
+  std::optional<Eigen::Vector3d> direction;
   // File units to millimetres: 1 for mm files, 25.4 for inch files.
   double scale_to_mm = 1.0;
   // Vertices closer than this fraction of the bounding-box diagonal are one vertex.
@@ -94,6 +97,9 @@ struct Mesh {
   // The defect with this code, or nullptr.
   const Defect* find_defect(std::string_view code) const;
 };
+
+// The rotation that takes the model's build direction to +Z (axis permutations are exact).
+Eigen::Matrix3d build_frame_rotation(const MeshParams& params);
 
 // Weld, repair, orient, find shells and surfaces. Fails only when nothing usable is left
 // (no finite, non-degenerate facet); every other problem becomes a Defect.
