@@ -232,6 +232,8 @@ WeldResult weld_soup(const TriangleSoup& soup, const MeshParams& params) {
   };
   auto corner_hash = [&](std::size_t c) { return grid.hash(soup.corners[c].cast<double>()); };
 
+  constexpr std::size_t kRecent = 1 << 14;
+  std::vector<Slot> recent(kRecent, Slot{{0, 0, 0}, -1});
   bool facet_ok = true;
   std::uint64_t ring[kAhead];
   for (std::size_t c = 0; c < std::min(nc, kAhead); ++c) ring[c] = corner_hash(c);
@@ -250,6 +252,13 @@ WeldResult weld_soup(const TriangleSoup& soup, const MeshParams& params) {
       continue;
     }
     const Key k = key_of(soup.corners[c]);
+    // Neighbouring facets of a file share corners a few facets apart: a small cache of recent
+    // points answers most repeats without touching the big table (a cache miss each).
+    Slot& cached = recent[(h ^ (h >> 17)) & (kRecent - 1)];
+    if (cached.id >= 0 && same(cached.k, k)) {
+      w.corner_point[c] = cached.id;
+      continue;
+    }
     std::size_t s = h & mask;
     std::int32_t found = -1;
     for (; table[s].id >= 0; s = (s + 1) & mask) {
@@ -258,8 +267,9 @@ WeldResult weld_soup(const TriangleSoup& soup, const MeshParams& params) {
         break;
       }
     }
-    if (found >= 0) {  // the common case: a point seen before
+    if (found >= 0) {  // a point seen before
       w.corner_point[c] = found;
+      cached = Slot{k, found};
       continue;
     }
 
@@ -294,6 +304,7 @@ WeldResult weld_soup(const TriangleSoup& soup, const MeshParams& params) {
       }
     }
     table[s] = Slot{k, i};
+    cached = Slot{k, i};
     w.corner_point[c] = i;
     if (keys.size() * 2 > cap) grow();
   }
