@@ -15,19 +15,13 @@ namespace lamina {
 namespace {
 
 using mesh_test::box;
+using mesh_test::build_checked;
 using mesh_test::structure_problem;
 using mesh_test::unit_cube;
 
-Mesh build(const TriangleSoup& soup, const MeshParams& params = {}) {
-  auto r = build_mesh(soup, params);
-  EXPECT_TRUE(r.has_value()) << (r ? "" : r.error().message);
-  if (!r) return Mesh{};
-  EXPECT_EQ(structure_problem(*r), "");
-  return std::move(*r);
-}
 
 TEST(BuildMesh, UnitCubeCountsAndVolume) {
-  const Mesh m = build(unit_cube());
+  const Mesh m = build_checked(unit_cube());
   EXPECT_EQ(m.summary.triangles_read, 12u);
   EXPECT_EQ(m.summary.triangles, 12u);
   EXPECT_EQ(m.summary.vertices, 8u);
@@ -49,7 +43,7 @@ TEST(BuildMesh, UnitCubeCountsAndVolume) {
 }
 
 TEST(BuildMesh, CubeSurfacesAreTheSixFacesWithOutwardNormals) {
-  const Mesh m = build(unit_cube());
+  const Mesh m = build_checked(unit_cube());
   // Facets 2k and 2k+1 form face k of the soup; each face is one surface, ids by seed order.
   for (int k = 0; k < 6; ++k) {
     EXPECT_EQ(m.surface_id[static_cast<std::size_t>(2 * k)], k);
@@ -63,13 +57,13 @@ TEST(BuildMesh, CubeSurfacesAreTheSixFacesWithOutwardNormals) {
 TEST(BuildMesh, SharpAngleAboveNinetyDegreesMergesTheWholeCube) {
   MeshParams p;
   p.sharp_angle_rad = 91.0 * std::numbers::pi / 180.0;
-  EXPECT_EQ(build(unit_cube(), p).summary.surfaces, 1);
+  EXPECT_EQ(build_checked(unit_cube(), p).summary.surfaces, 1);
   p.sharp_angle_rad = 89.0 * std::numbers::pi / 180.0;
-  EXPECT_EQ(build(unit_cube(), p).summary.surfaces, 6);
+  EXPECT_EQ(build_checked(unit_cube(), p).summary.surfaces, 6);
 }
 
 TEST(BuildMesh, LowestPointMovesToZeroAndXYStay) {
-  const Mesh m = build(box({5, 6, 7}, {6, 8, 10}));
+  const Mesh m = build_checked(box({5, 6, 7}, {6, 8, 10}));
   EXPECT_EQ(m.summary.bbox_min_mm, Eigen::Vector3d(5, 6, 0));
   EXPECT_EQ(m.summary.bbox_max_mm, Eigen::Vector3d(6, 8, 3));
   EXPECT_NEAR(m.summary.volume_mm3, 6.0, 1e-12);
@@ -78,7 +72,7 @@ TEST(BuildMesh, LowestPointMovesToZeroAndXYStay) {
 TEST(BuildMesh, BuildAxisXPutsModelXUp) {
   MeshParams p;
   p.axis = BuildAxis::x;
-  const Mesh m = build(box({5, 6, 7}, {6, 8, 10}), p);  // 1 × 2 × 3
+  const Mesh m = build_checked(box({5, 6, 7}, {6, 8, 10}), p);  // 1 × 2 × 3
   // (x, y, z) → (y, z, x): heights come from x.
   EXPECT_EQ(m.summary.bbox_min_mm, Eigen::Vector3d(6, 7, 0));
   EXPECT_EQ(m.summary.bbox_max_mm, Eigen::Vector3d(8, 10, 1));
@@ -89,7 +83,7 @@ TEST(BuildMesh, BuildAxisXPutsModelXUp) {
 TEST(BuildMesh, BuildAxisYPutsModelYUp) {
   MeshParams p;
   p.axis = BuildAxis::y;
-  const Mesh m = build(box({5, 6, 7}, {6, 8, 10}), p);
+  const Mesh m = build_checked(box({5, 6, 7}, {6, 8, 10}), p);
   // (x, y, z) → (z, x, y).
   EXPECT_EQ(m.summary.bbox_min_mm, Eigen::Vector3d(7, 5, 0));
   EXPECT_EQ(m.summary.bbox_max_mm, Eigen::Vector3d(10, 6, 2));
@@ -100,7 +94,7 @@ TEST(BuildMesh, BuildAxisYPutsModelYUp) {
 TEST(BuildMesh, InchScale) {
   MeshParams p;
   p.scale_to_mm = 25.4;
-  const Mesh m = build(box({0, 0, 0}, {1, 2, 3}), p);
+  const Mesh m = build_checked(box({0, 0, 0}, {1, 2, 3}), p);
   EXPECT_NEAR(m.summary.bbox_max_mm.z(), 76.2, 1e-12);
   EXPECT_NEAR(m.summary.bbox_max_mm.x(), 25.4, 1e-12);
   EXPECT_NEAR(m.summary.volume_mm3, 6.0 * 25.4 * 25.4 * 25.4, 1e-9);
@@ -108,7 +102,7 @@ TEST(BuildMesh, InchScale) {
 
 TEST(BuildMesh, UvSphereIsOneSmoothSurface) {
   const TriangleSoup s = mesh_test::uv_sphere(10.0, 48, 24);
-  const Mesh m = build(s);
+  const Mesh m = build_checked(s);
   EXPECT_EQ(m.summary.triangles, 48u * 2 + 48u * 22 * 2);
   EXPECT_EQ(m.summary.vertices, 2u + 48u * 23);
   EXPECT_EQ(m.edges.size(), 3 * m.summary.triangles / 2);
@@ -133,7 +127,7 @@ TEST(BuildMesh, UvSphereIsOneSmoothSurface) {
 TEST(BuildMesh, SphereSplitsIntoManySurfacesWithATinyThreshold) {
   MeshParams p;
   p.sharp_angle_rad = 1.0 * std::numbers::pi / 180.0;  // adjacent quads are 7.5° apart
-  const Mesh m = build(mesh_test::uv_sphere(10.0, 48, 24), p);
+  const Mesh m = build_checked(mesh_test::uv_sphere(10.0, 48, 24), p);
   // The two halves of each quad (coplanar) stay together: 48·22 quads. Each pole fan is one
   // surface: its neighbours are only 7.5° · sin(3.75°) ≈ 0.5° apart.
   EXPECT_EQ(m.summary.surfaces, 48 * 22 + 2);
@@ -141,7 +135,7 @@ TEST(BuildMesh, SphereSplitsIntoManySurfacesWithATinyThreshold) {
 
 TEST(BuildMesh, CylinderHasSideAndTwoCaps) {
   const TriangleSoup s = mesh_test::cylinder(5.0, 20.0, 32);
-  const Mesh m = build(s);
+  const Mesh m = build_checked(s);
   EXPECT_TRUE(m.summary.watertight);
   EXPECT_EQ(m.summary.surfaces, 3);
   EXPECT_NEAR(m.summary.volume_mm3, mesh_test::soup_volume(s), 1e-9 * mesh_test::soup_volume(s));
@@ -159,13 +153,13 @@ TEST(BuildMesh, CylinderHasSideAndTwoCaps) {
 
 TEST(BuildMesh, TwelveGonCylinderSideStaysOneSurfaceAtExactlyThirtyDegrees) {
   // Neighbouring side facets of a 12-gon are exactly 30° apart: "≤ threshold" joins them.
-  EXPECT_EQ(build(mesh_test::cylinder(5.0, 20.0, 12)).summary.surfaces, 3);
-  EXPECT_EQ(build(mesh_test::cylinder(5.0, 20.0, 11)).summary.surfaces, 2 + 11);
+  EXPECT_EQ(build_checked(mesh_test::cylinder(5.0, 20.0, 12)).summary.surfaces, 3);
+  EXPECT_EQ(build_checked(mesh_test::cylinder(5.0, 20.0, 11)).summary.surfaces, 2 + 11);
 }
 
 TEST(BuildMesh, SameInputSameOutput) {
   const TriangleSoup s = mesh_test::append(mesh_test::uv_sphere(3.0, 16, 8), mesh_test::perturbed(unit_cube()));
-  const Mesh a = build(s), b = build(s);
+  const Mesh a = build_checked(s), b = build_checked(s);
   EXPECT_EQ(a.vertices, b.vertices);
   EXPECT_EQ(a.faces, b.faces);
   EXPECT_EQ(a.surface_id, b.surface_id);
@@ -180,8 +174,8 @@ TEST(BuildMesh, ThreadCountDoesNotChangeTheResult) {
                                            mesh_test::inverted(box({100, 0, 0}, {101, 1, 1})));
   Mesh serial, parallel;
   tbb::task_arena one(1);
-  one.execute([&] { serial = build(s); });
-  parallel = build(s);
+  one.execute([&] { serial = build_checked(s); });
+  parallel = build_checked(s);
   EXPECT_EQ(serial.summary.triangles, 2u * 256 * 159 + 12);
   EXPECT_TRUE(serial.summary.watertight);
   EXPECT_EQ(serial.summary.shells, 2);

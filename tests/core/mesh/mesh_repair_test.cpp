@@ -15,17 +15,11 @@ namespace {
 
 using mesh_test::append;
 using mesh_test::box;
+using mesh_test::build_checked;
 using mesh_test::inverted;
 using mesh_test::structure_problem;
 using mesh_test::unit_cube;
 
-Mesh build(const TriangleSoup& soup, const MeshParams& params = {}) {
-  auto r = build_mesh(soup, params);
-  EXPECT_TRUE(r.has_value()) << (r ? "" : r.error().message);
-  if (!r) return Mesh{};
-  EXPECT_EQ(structure_problem(*r), "");
-  return std::move(*r);
-}
 
 std::size_t defect_count(const Mesh& m, std::string_view code) {
   const Defect* d = m.find_defect(code);
@@ -36,7 +30,7 @@ std::size_t defect_count(const Mesh& m, std::string_view code) {
 
 TEST(MeshRepair, PerturbedCubeIsWeldedBackTogether) {
   const TriangleSoup s = mesh_test::perturbed(unit_cube());
-  const Mesh m = build(s);
+  const Mesh m = build_checked(s);
   EXPECT_EQ(m.summary.vertices, 8u);
   EXPECT_EQ(m.edges.size(), 18u);
   EXPECT_TRUE(m.summary.watertight);
@@ -54,7 +48,7 @@ TEST(MeshRepair, PerturbedCubeIsWeldedBackTogether) {
 TEST(MeshRepair, ExactWeldAloneLeavesThePerturbedCubeOpen) {
   MeshParams p;
   p.weld_tolerance_rel = 0.0;
-  const Mesh m = build(mesh_test::perturbed(unit_cube()), p);
+  const Mesh m = build_checked(mesh_test::perturbed(unit_cube()), p);
   EXPECT_GT(m.summary.vertices, 8u);
   EXPECT_GT(m.summary.boundary_edges, 0u);
   EXPECT_FALSE(m.summary.watertight);
@@ -63,7 +57,7 @@ TEST(MeshRepair, ExactWeldAloneLeavesThePerturbedCubeOpen) {
 }
 
 TEST(MeshRepair, CleanCubeReportsNoWeld) {
-  EXPECT_EQ(build(unit_cube()).find_defect("welded_vertices"), nullptr);
+  EXPECT_EQ(build_checked(unit_cube()).find_defect("welded_vertices"), nullptr);
 }
 
 TEST(MeshRepair, ToleranceComesFromTheWholeModelNotASample) {
@@ -78,7 +72,7 @@ TEST(MeshRepair, ToleranceComesFromTheWholeModelNotASample) {
   mesh_test::add_tri(s, {1000, 1000, 1000}, {1001, 1000, 1000}, {1000, 1001, 1000});  // facet 1
   s.corners.insert(s.corners.end(), sphere.corners.begin() + 3, sphere.corners.end());
   ASSERT_GE(s.triangle_count(), 8192u);
-  const Mesh m = build(s);
+  const Mesh m = build_checked(s);
   EXPECT_EQ(m.summary.boundary_edges, 3u);  // only the lone triangle's
   EXPECT_EQ(m.summary.shells, 2);
   EXPECT_TRUE(m.shell_info[0].closed);
@@ -93,14 +87,14 @@ TEST(MeshRepair, MinusZeroIsZeroEvenForTheExactWeld) {
       if (s.corners[c][a] == 0.0f) s.corners[c][a] = -0.0f;
   MeshParams p;
   p.weld_tolerance_rel = 0.0;
-  const Mesh m = build(s, p);
+  const Mesh m = build_checked(s, p);
   EXPECT_EQ(m.summary.vertices, 8u);
   EXPECT_TRUE(m.summary.watertight);
 }
 
 TEST(MeshRepair, PointsFartherThanTheToleranceStayApart) {
   // Two cubes 1e-3 apart (tolerance is 1e-7 × diagonal ≈ 3e-7): no weld, two shells.
-  const Mesh m = build(append(unit_cube(), box({1.001f, 0, 0}, {2.001f, 1, 1})));
+  const Mesh m = build_checked(append(unit_cube(), box({1.001f, 0, 0}, {2.001f, 1, 1})));
   EXPECT_EQ(m.summary.vertices, 16u);
   EXPECT_EQ(m.summary.shells, 2);
   EXPECT_EQ(m.find_defect("welded_vertices"), nullptr);
@@ -111,7 +105,7 @@ TEST(MeshRepair, PointsFartherThanTheToleranceStayApart) {
 TEST(MeshRepair, OneFlippedFacetIsTurnedBack) {
   TriangleSoup s = unit_cube();
   mesh_test::flip_facet(s, 5);
-  const Mesh m = build(s);
+  const Mesh m = build_checked(s);
   const Defect* d = m.find_defect("inconsistent_winding");
   ASSERT_NE(d, nullptr);
   EXPECT_EQ(d->severity, Severity::repaired);
@@ -127,13 +121,13 @@ TEST(MeshRepair, OneFlippedFacetIsTurnedBack) {
 TEST(MeshRepair, MinorityOfFacetsIsFlipped) {
   TriangleSoup s = unit_cube();
   for (std::size_t f : {0u, 1u, 2u, 3u, 4u, 5u, 6u, 7u}) mesh_test::flip_facet(s, f);  // 8 of 12
-  const Mesh m = build(s);
+  const Mesh m = build_checked(s);
   EXPECT_EQ(defect_count(m, "inconsistent_winding"), 4u);
   EXPECT_NEAR(m.summary.volume_mm3, 1.0, 1e-12);
 }
 
 TEST(MeshRepair, InsideOutCubeIsTurnedOver) {
-  const Mesh m = build(inverted(unit_cube()));
+  const Mesh m = build_checked(inverted(unit_cube()));
   const Defect* d = m.find_defect("inside_out");
   ASSERT_NE(d, nullptr);
   EXPECT_EQ(d->severity, Severity::repaired);
@@ -149,7 +143,7 @@ TEST(MeshRepair, InsideOutCubeIsTurnedOver) {
 TEST(MeshRepair, CubeWithCavityKeepsTheCavityNegative) {
   // Outer 3³ outward, inner 1³ cavity wound inward (as a correct file has it).
   const TriangleSoup s = append(box({0, 0, 0}, {3, 3, 3}), inverted(box({1, 1, 1}, {2, 2, 2})));
-  const Mesh m = build(s);
+  const Mesh m = build_checked(s);
   EXPECT_NEAR(m.summary.volume_mm3, 26.0, 1e-12);
   ASSERT_EQ(m.summary.shells, 2);
   EXPECT_NEAR(m.shell_info[0].volume_mm3, 27.0, 1e-12);
@@ -167,14 +161,14 @@ TEST(MeshRepair, CubeWithCavityKeepsTheCavityNegative) {
 }
 
 TEST(MeshRepair, CavityWoundOutwardIsTurnedInward) {
-  const Mesh m = build(append(box({0, 0, 0}, {3, 3, 3}), box({1, 1, 1}, {2, 2, 2})));
+  const Mesh m = build_checked(append(box({0, 0, 0}, {3, 3, 3}), box({1, 1, 1}, {2, 2, 2})));
   EXPECT_EQ(defect_count(m, "inside_out"), 1u);
   EXPECT_NEAR(m.summary.volume_mm3, 26.0, 1e-12);
   EXPECT_NEAR(m.shell_info[1].volume_mm3, -1.0, 1e-12);
 }
 
 TEST(MeshRepair, EverythingInvertedIsTurnedBack) {
-  const Mesh m = build(inverted(append(box({0, 0, 0}, {3, 3, 3}), inverted(box({1, 1, 1}, {2, 2, 2})))));
+  const Mesh m = build_checked(inverted(append(box({0, 0, 0}, {3, 3, 3}), inverted(box({1, 1, 1}, {2, 2, 2})))));
   EXPECT_EQ(defect_count(m, "inside_out"), 2u);
   EXPECT_NEAR(m.summary.volume_mm3, 26.0, 1e-12);
 }
@@ -183,7 +177,7 @@ TEST(MeshRepair, IslandInsideACavityIsASolidAgain) {
   // Solid 5³, cavity 3³, and a 1³ solid floating in the cavity, all given wound outward.
   const TriangleSoup s =
       append(append(box({0, 0, 0}, {5, 5, 5}), box({1, 1, 1}, {4, 4, 4})), box({2, 2, 2}, {3, 3, 3}));
-  const Mesh m = build(s);
+  const Mesh m = build_checked(s);
   ASSERT_EQ(m.summary.shells, 3);
   EXPECT_EQ(m.shell_info[0].depth, 0);
   EXPECT_EQ(m.shell_info[1].depth, 1);
@@ -203,7 +197,7 @@ TEST(MeshRepair, ManyVoidsInABlockAreAllCavities) {
                                  2.0f + 4.0f * static_cast<float>(k));
         s = append(s, box(lo, lo + Eigen::Vector3f::Constant(0.5f)));
       }
-  const Mesh m = build(s);
+  const Mesh m = build_checked(s);
   ASSERT_EQ(m.summary.shells, 401);
   EXPECT_EQ(defect_count(m, "inside_out"), 400u);
   EXPECT_NEAR(m.summary.volume_mm3, 8000.0 - 400 * 0.125, 1e-6);
@@ -218,7 +212,7 @@ TEST(MeshRepair, ManyVoidsInABlockAreAllCavities) {
 TEST(MeshRepair, SphericalCavityInASphere) {
   // Curved, finely faceted container: the cavity (given outward) is found inside it.
   const TriangleSoup outer = mesh_test::uv_sphere(10.0, 64, 32), inner = mesh_test::uv_sphere(4.0, 32, 16, {1, 0, 0.5});
-  const Mesh m = build(append(outer, inner));
+  const Mesh m = build_checked(append(outer, inner));
   ASSERT_EQ(m.summary.shells, 2);
   EXPECT_EQ(m.shell_info[1].depth, 1);
   EXPECT_EQ(defect_count(m, "inside_out"), 1u);
@@ -227,7 +221,7 @@ TEST(MeshRepair, SphericalCavityInASphere) {
 
 TEST(MeshRepair, OverlappingSolidsAreNotCavities) {
   // Two intersecting boxes, neither inside the other: both stay solids.
-  const Mesh m = build(append(box({0, 0, 0}, {2, 2, 2}), box({1, 0.5f, 0.5f}, {3, 1.5f, 1.5f})));
+  const Mesh m = build_checked(append(box({0, 0, 0}, {2, 2, 2}), box({1, 0.5f, 0.5f}, {3, 1.5f, 1.5f})));
   ASSERT_EQ(m.summary.shells, 2);
   EXPECT_GT(m.shell_info[0].volume_mm3, 0.0);
   EXPECT_GT(m.shell_info[1].volume_mm3, 0.0);
@@ -235,7 +229,7 @@ TEST(MeshRepair, OverlappingSolidsAreNotCavities) {
 }
 
 TEST(MeshRepair, TwoDisjointCubes) {
-  const Mesh m = build(append(unit_cube(), inverted(box({3, 0, 0}, {4, 1, 1}))));
+  const Mesh m = build_checked(append(unit_cube(), inverted(box({3, 0, 0}, {4, 1, 1}))));
   EXPECT_EQ(m.summary.shells, 2);
   EXPECT_EQ(defect_count(m, "multiple_shells"), 2u);
   EXPECT_EQ(defect_count(m, "inside_out"), 1u);
@@ -249,7 +243,7 @@ TEST(MeshRepair, TwoDisjointCubes) {
 // ---- open and non-manifold -----------------------------------------------------------------------
 
 TEST(MeshRepair, MissingFacetLeavesOpenEdges) {
-  const Mesh m = build(mesh_test::without_facet(unit_cube(), 3));  // half of the +z face
+  const Mesh m = build_checked(mesh_test::without_facet(unit_cube(), 3));  // half of the +z face
   EXPECT_EQ(m.summary.boundary_edges, 3u);
   EXPECT_FALSE(m.summary.watertight);
   EXPECT_FALSE(m.usable());
@@ -264,7 +258,7 @@ TEST(MeshRepair, MissingFacetLeavesOpenEdges) {
 }
 
 TEST(MeshRepair, TwoHolesAreTwoPlaces) {
-  const Mesh m = build(mesh_test::without_facet(mesh_test::without_facet(unit_cube(), 3), 0));  // top and bottom
+  const Mesh m = build_checked(mesh_test::without_facet(mesh_test::without_facet(unit_cube(), 3), 0));  // top and bottom
   const Defect* d = m.find_defect("open_edges");
   ASSERT_NE(d, nullptr);
   EXPECT_EQ(d->count, 6u);
@@ -273,7 +267,7 @@ TEST(MeshRepair, TwoHolesAreTwoPlaces) {
 
 TEST(MeshRepair, CubesSharingAnEdgeAreNonManifoldAndTwoShells) {
   // The second cube touches the first along the vertical edge x = 1, y = 1; it is inside out.
-  const Mesh m = build(append(unit_cube(), inverted(box({1, 1, 0}, {2, 2, 1}))));
+  const Mesh m = build_checked(append(unit_cube(), inverted(box({1, 1, 0}, {2, 2, 1}))));
   EXPECT_EQ(m.summary.nonmanifold_edges, 1u);
   EXPECT_EQ(m.summary.boundary_edges, 0u);
   EXPECT_EQ(m.summary.shells, 2);  // the non-manifold edge does not join them
@@ -298,7 +292,7 @@ TEST(MeshRepair, DegenerateFacetsAreDropped) {
   TriangleSoup s = unit_cube();
   mesh_test::add_tri(s, {0, 0, 0}, {0, 0, 0}, {1, 0, 0});      // repeated corner
   mesh_test::add_tri(s, {0, 0, 0}, {0.5f, 0, 0}, {1, 0, 0});   // collinear: zero area
-  const Mesh m = build(s);
+  const Mesh m = build_checked(s);
   EXPECT_EQ(m.summary.triangles_read, 14u);
   EXPECT_EQ(m.summary.triangles, 12u);
   EXPECT_EQ(m.summary.vertices, 8u);  // (0.5, 0, 0) was only used by a dropped facet
@@ -314,7 +308,7 @@ TEST(MeshRepair, DegenerateFacetsAreDropped) {
 TEST(MeshRepair, FacetCollapsedByTheWeldIsDegenerate) {
   TriangleSoup s = unit_cube();
   mesh_test::add_tri(s, {0, 0, 0}, {1e-9f, 0, 0}, {1, 1, 1});  // two corners weld into one
-  const Mesh m = build(s);
+  const Mesh m = build_checked(s);
   EXPECT_EQ(defect_count(m, "degenerate_facets"), 1u);
   EXPECT_EQ(m.summary.triangles, 12u);
 }
@@ -323,7 +317,7 @@ TEST(MeshRepair, NanCornerDropsItsFacet) {
   TriangleSoup s = unit_cube();
   mesh_test::add_tri(s, {0, 0, 0}, {std::numeric_limits<float>::quiet_NaN(), 0, 0}, {1, 1, 1});
   mesh_test::add_tri(s, {0, 0, 0}, {1, std::numeric_limits<float>::infinity(), 0}, {1, 1, 1});
-  const Mesh m = build(s);
+  const Mesh m = build_checked(s);
   const Defect* d = m.find_defect("nan_coordinates");
   ASSERT_NE(d, nullptr);
   EXPECT_EQ(d->severity, Severity::repaired);
@@ -363,7 +357,7 @@ TEST(MeshRepair, OnlyDegenerateFacetsIsAnError) {
 TEST(MeshRepair, SingleTriangleIsOpen) {
   TriangleSoup s;
   mesh_test::add_tri(s, {0, 0, 0}, {1, 0, 0}, {0, 1, 0});
-  const Mesh m = build(s);
+  const Mesh m = build_checked(s);
   EXPECT_EQ(m.summary.boundary_edges, 3u);
   EXPECT_FALSE(m.usable());
   EXPECT_EQ(m.find_defect("inside_out"), nullptr);  // a flat patch has no inside

@@ -1,6 +1,7 @@
 // Slicing on solids whose sections are known exactly: boxes, an octahedron, cavities, open and
 // non-manifold meshes, overlapping shells.
-#include "boxes.hpp"
+#include "mesh_checks.hpp"
+#include "mesh_soups.hpp"
 #include "lamina/core/mesh.hpp"
 #include "lamina/core/slice.hpp"
 
@@ -11,14 +12,7 @@
 namespace lamina {
 namespace {
 
-using test::append_box;
-using test::box;
-
-Mesh build(const TriangleSoup& soup) {
-  auto m = build_mesh(soup, MeshParams{});
-  EXPECT_TRUE(m.has_value()) << (m ? "" : m.error().message);
-  return m ? std::move(*m) : Mesh{};
-}
+using mesh_test::box;
 
 std::vector<Slice> cut(const Mesh& mesh, std::vector<double> zs, SliceParams p = {}) {
   auto s = slice_mesh(mesh, zs, p);
@@ -27,7 +21,7 @@ std::vector<Slice> cut(const Mesh& mesh, std::vector<double> zs, SliceParams p =
 }
 
 TEST(SliceBasic, BoxGivesOneCcwLoopWithFacetAttributes) {
-  const Mesh mesh = build(box({0, 0, 0}, {10, 20, 30}));
+  const Mesh mesh = mesh_test::build_checked(box({0, 0, 0}, {10, 20, 30}));
   const auto slices = cut(mesh, {15.0});
   ASSERT_EQ(slices.size(), 1u);
   const Slice& s = slices[0];
@@ -60,7 +54,7 @@ TEST(SliceBasic, BoxGivesOneCcwLoopWithFacetAttributes) {
 TEST(SliceBasic, PlaneThroughVerticesFollowsTheAboveRule) {
   // On-plane vertices count as above: the top face plane cuts the walls (full section), the
   // bottom face plane cuts nothing — each plane belongs to exactly one side of a horizontal face.
-  const Mesh mesh = build(box({0, 0, 0}, {10, 20, 30}));
+  const Mesh mesh = mesh_test::build_checked(box({0, 0, 0}, {10, 20, 30}));
   const auto slices = cut(mesh, {0.0, 30.0, 30.0 + 1e-9, -1.0});
   EXPECT_TRUE(slices[0].loops.empty());
   ASSERT_EQ(slices[1].loops.size(), 1u);
@@ -76,7 +70,7 @@ TEST(SliceBasic, OctahedronEquatorThroughFourVertices) {
            {px, py, pz}, {py, nx, pz}, {nx, ny, pz}, {ny, px, pz},
            {py, px, nz}, {nx, py, nz}, {ny, nx, nz}, {px, ny, nz}})
     for (const auto& c : t) soup.corners.push_back(c);
-  const Mesh mesh = build(soup);
+  const Mesh mesh = mesh_test::build_checked(soup);
   const auto slices = cut(mesh, {1.0, 0.5, 1.5});
   ASSERT_EQ(slices[0].loops.size(), 1u);
   EXPECT_EQ(slices[0].loops[0].size(), 4u) << "the four lower facets give the diamond, no zero-length vector";
@@ -87,8 +81,8 @@ TEST(SliceBasic, OctahedronEquatorThroughFourVertices) {
 
 TEST(SliceBasic, CavityIsAClockwiseHoleInsideTheOuterLoop) {
   TriangleSoup soup = box({0, 0, 0}, {10, 10, 10});
-  test::append_inverted_box(soup, {2, 3, 2}, {6, 8, 8});
-  const Mesh mesh = build(soup);
+  soup = mesh_test::append(soup, mesh_test::inverted(box({2, 3, 2}, {6, 8, 8})));
+  const Mesh mesh = mesh_test::build_checked(soup);
   const auto s = cut(mesh, {5.0})[0];
   ASSERT_EQ(s.loops.size(), 2u);
   EXPECT_EQ(s.outer_count(), 1);
@@ -103,10 +97,9 @@ TEST(SliceBasic, CavityIsAClockwiseHoleInsideTheOuterLoop) {
 }
 
 TEST(SliceBasic, OpenMeshChainIsReportedAndClosedByTheGapRule) {
-  TriangleSoup soup = box({0, 0, 0}, {10, 20, 30});
-  // Remove one triangle of the +x wall (triangles 10 and 11 are that wall).
-  soup.corners.erase(soup.corners.begin() + 30, soup.corners.begin() + 33);
-  const Mesh mesh = build(soup);
+  // Remove one triangle of the +x wall (the box's last quad, facets 10 and 11).
+  const TriangleSoup soup = mesh_test::without_facet(box({0, 0, 0}, {10, 20, 30}), 10);
+  const Mesh mesh = mesh_test::build_checked(soup);
   EXPECT_FALSE(mesh.usable());
 
   SliceParams off;
@@ -137,8 +130,8 @@ TEST(SliceBasic, OpenMeshChainIsReportedAndClosedByTheGapRule) {
 
 TEST(SliceBasic, BoxesTouchingAlongAnEdgeStayTwoLoops) {
   TriangleSoup soup = box({0, 0, 0}, {1, 1, 1});
-  append_box(soup, {1, 1, 0}, {2, 2, 1});
-  const Mesh mesh = build(soup);
+  soup = mesh_test::append(soup, box({1, 1, 0}, {2, 2, 1}));
+  const Mesh mesh = mesh_test::build_checked(soup);
   const auto s = cut(mesh, {0.5})[0];
   ASSERT_EQ(s.loops.size(), 2u);
   EXPECT_EQ(s.outer_count(), 2);
@@ -150,8 +143,8 @@ TEST(SliceBasic, BoxesTouchingAlongAnEdgeStayTwoLoops) {
 
 TEST(SliceBasic, OverlappingShellsSliceToTheirUnion) {
   TriangleSoup soup = box({0, 0, 0}, {10, 10, 10});
-  append_box(soup, {5, 5, 2}, {15, 15, 8});
-  const Mesh mesh = build(soup);
+  soup = mesh_test::append(soup, box({5, 5, 2}, {15, 15, 8}));
+  const Mesh mesh = mesh_test::build_checked(soup);
   const auto slices = cut(mesh, {5.0, 9.0});
   const Slice& both = slices[0];
   ASSERT_EQ(both.loops.size(), 1u);
@@ -165,11 +158,11 @@ TEST(SliceBasic, OverlappingShellsSliceToTheirUnion) {
 TEST(SliceBasic, OverlapCreatingAnEnclosedHole) {
   // Two U-shaped bodies overlapping into a ring: the union has an outer loop and a hole.
   TriangleSoup soup;
-  append_box(soup, {0, 0, 0}, {10, 3, 5});   // bottom bar
-  append_box(soup, {0, 7, 0}, {10, 10, 5});  // top bar
-  append_box(soup, {-1, -1, 0}, {3, 11, 5}); // left bar overlapping both
-  append_box(soup, {7, -1, 0}, {11, 11, 5}); // right bar overlapping both
-  const Mesh mesh = build(soup);
+  soup = mesh_test::append(soup, box({0, 0, 0}, {10, 3, 5}));   // bottom bar
+  soup = mesh_test::append(soup, box({0, 7, 0}, {10, 10, 5}));  // top bar
+  soup = mesh_test::append(soup, box({-1, -1, 0}, {3, 11, 5})); // left bar overlapping both
+  soup = mesh_test::append(soup, box({7, -1, 0}, {11, 11, 5})); // right bar overlapping both
+  const Mesh mesh = mesh_test::build_checked(soup);
   const auto s = cut(mesh, {2.5})[0];
   EXPECT_EQ(s.outer_count(), 1);
   EXPECT_EQ(s.hole_count(), 1);
@@ -180,8 +173,8 @@ TEST(SliceBasic, OverlapCreatingAnEnclosedHole) {
 
 TEST(SliceBasic, ParallelAndSerialAgreeAndOrderFollowsInput) {
   TriangleSoup soup = box({0, 0, 0}, {10, 10, 10});
-  test::append_inverted_box(soup, {2, 2, 2}, {8, 8, 8});
-  const Mesh mesh = build(soup);
+  soup = mesh_test::append(soup, mesh_test::inverted(box({2, 2, 2}, {8, 8, 8})));
+  const Mesh mesh = mesh_test::build_checked(soup);
   std::vector<double> zs{9.0, 1.0, 5.0, 3.3, 7.7};
   SliceParams serial;
   serial.parallel = false;
@@ -197,7 +190,7 @@ TEST(SliceBasic, ParallelAndSerialAgreeAndOrderFollowsInput) {
 }
 
 TEST(SliceBasic, RejectsNonFiniteHeights) {
-  const Mesh mesh = build(box({0, 0, 0}, {1, 1, 1}));
+  const Mesh mesh = mesh_test::build_checked(box({0, 0, 0}, {1, 1, 1}));
   std::vector<double> zs{0.5, std::numeric_limits<double>::quiet_NaN()};
   auto r = slice_mesh(mesh, zs, SliceParams{});
   ASSERT_FALSE(r.has_value());

@@ -3,6 +3,7 @@
 // arbitrarily and sliced along the rotated build direction (seeded property test).
 #include "lamina/core/mesh.hpp"
 #include "lamina/core/slice.hpp"
+#include "mesh_checks.hpp"
 #include "shapes.hpp"
 
 #include <Eigen/Geometry>
@@ -14,12 +15,6 @@ namespace lamina {
 namespace {
 
 constexpr double kRel = 5e-4;  // 0.05 %
-
-Mesh build(const TriangleSoup& soup, const MeshParams& p = {}) {
-  auto m = build_mesh(soup, p);
-  EXPECT_TRUE(m.has_value()) << (m ? "" : m.error().message);
-  return m ? std::move(*m) : Mesh{};
-}
 
 std::vector<Slice> cut(const Mesh& mesh, const std::vector<double>& zs) {
   auto s = slice_mesh(mesh, zs, SliceParams{});
@@ -37,7 +32,7 @@ std::vector<double> random_heights(std::mt19937& rng, double lo, double hi, int 
 TEST(SliceShapes, SphereSectionsMatchTheFacetedSolid) {
   const double r = 50.0;
   const int seg = 96, rings = 48;
-  const Mesh mesh = build(test::uv_sphere(r, seg, rings));
+  const Mesh mesh = mesh_test::build_checked(test::uv_sphere(r, seg, rings));
   std::mt19937 rng(7);
   const auto zs = random_heights(rng, 0.01, 2 * r - 0.01, 40);
   const auto slices = cut(mesh, zs);
@@ -52,7 +47,7 @@ TEST(SliceShapes, SphereSectionsMatchTheFacetedSolid) {
 TEST(SliceShapes, TubeHasOneOuterAndOneNestedHole) {
   const double R = 30, r = 12, h = 40;
   const int seg = 64;
-  const Mesh mesh = build(test::tube(R, r, h, seg));
+  const Mesh mesh = mesh_test::build_checked(test::tube(R, r, h, seg));
   std::mt19937 rng(11);
   const auto zs = random_heights(rng, 0.1, h - 0.1, 20);
   const auto slices = cut(mesh, zs);
@@ -80,7 +75,7 @@ TEST(SliceShapes, TubeHasOneOuterAndOneNestedHole) {
 TEST(SliceShapes, TorusSectionsMatchTheFacetedSolid) {
   const double R = 30, r = 10;
   const int maj = 72, minr = 36;
-  const Mesh mesh = build(test::torus(R, r, maj, minr));
+  const Mesh mesh = mesh_test::build_checked(test::torus(R, r, maj, minr));
   const double zmin = test::torus_z_min(r, minr), zmax = test::torus_z_max(r, minr);
   std::mt19937 rng(13);
   const auto zs = random_heights(rng, 0.05, zmax - zmin - 0.05, 30);
@@ -101,7 +96,7 @@ TEST(SliceShapes, AreasAreInvariantUnderRandomRotations) {
   std::mt19937 rng(2026);
   std::normal_distribution<double> g;
   for (const TriangleSoup* shape : {&torus, &tube}) {
-    const Mesh reference = build(*shape);
+    const Mesh reference = mesh_test::build_checked(*shape);
     const double h = reference.summary.bbox_max_mm.z();
     const std::vector<double> zs{0.13 * h, 0.37 * h, 0.5 * h, 0.71 * h, 0.93 * h};
     const auto want = cut(reference, zs);
@@ -112,7 +107,7 @@ TEST(SliceShapes, AreasAreInvariantUnderRandomRotations) {
       for (auto& c : rotated.corners) c = (q * c.cast<double>() + shift).cast<float>();
       MeshParams p;
       p.direction = q * Eigen::Vector3d::UnitZ();
-      const Mesh mesh = build(rotated, p);
+      const Mesh mesh = mesh_test::build_checked(rotated, p);
       EXPECT_NEAR(mesh.summary.bbox_max_mm.z(), h, 1e-4 * h);
       const auto got = cut(mesh, zs);
       for (std::size_t i = 0; i < zs.size(); ++i) {

@@ -2,6 +2,8 @@
 // Triangle soups built in code for the build_mesh tests: boxes, a UV sphere, a cylinder, and
 // helpers that damage them (flip, drop, append, perturb). Every shape is wound counter-clockwise
 // seen from outside unless a helper changes it.
+#include "shapes.hpp"
+
 #include <lamina/core/mesh.hpp>
 #include <lamina/core/triangle_soup.hpp>
 
@@ -84,32 +86,9 @@ inline TriangleSoup perturbed(TriangleSoup s) {
   return s;
 }
 
-// UV sphere: `segments` meridians, `rings` bands; pole fans, quads split in two.
+// UV sphere (tests/support/shapes.hpp) moved to centre c.
 inline TriangleSoup uv_sphere(double r, int segments, int rings, const Eigen::Vector3d& c = Eigen::Vector3d::Zero()) {
-  const double pi = std::numbers::pi;
-  auto p = [&](int i, int j) {  // ring i in 0..rings, meridian j
-    const double th = pi * i / rings, ph = 2.0 * pi * (j % segments) / segments;
-    if (i == 0) return Eigen::Vector3f((c + Eigen::Vector3d(0, 0, r)).cast<float>());
-    if (i == rings) return Eigen::Vector3f((c + Eigen::Vector3d(0, 0, -r)).cast<float>());
-    return Eigen::Vector3f(
-        (c + Eigen::Vector3d(r * std::sin(th) * std::cos(ph), r * std::sin(th) * std::sin(ph), r * std::cos(th)))
-            .cast<float>());
-  };
-  TriangleSoup s;
-  s.format = "test";
-  for (int i = 0; i < rings; ++i)
-    for (int j = 0; j < segments; ++j) {
-      // Going down in i and round in j (counter-clockwise seen from +z): outward is a, b, c with
-      // a = (i, j), below-left (i+1, j), below-right (i+1, j+1).
-      if (i == 0) {
-        add_tri(s, p(0, j), p(1, j), p(1, j + 1));
-      } else if (i == rings - 1) {
-        add_tri(s, p(i, j), p(rings, j), p(i, j + 1));
-      } else {
-        add_quad(s, p(i, j), p(i + 1, j), p(i + 1, j + 1), p(i, j + 1));
-      }
-    }
-  return s;
+  return test::translated(test::uv_sphere(r, segments, rings), c.cast<float>());
 }
 
 // Closed cylinder along z from 0 to h: side quads, cap fans about the axis.
@@ -131,15 +110,6 @@ inline TriangleSoup cylinder(double r, double h, int segments) {
   return s;
 }
 
-// Volume of the faceted sphere/cylinder computed from the same float corners (exact reference).
-inline double soup_volume(const TriangleSoup& s) {
-  double v = 0.0;
-  for (std::size_t f = 0; f < s.triangle_count(); ++f) {
-    const Eigen::Vector3d a = s.corners[3 * f].cast<double>(), b = s.corners[3 * f + 1].cast<double>(),
-                          c = s.corners[3 * f + 2].cast<double>();
-    v += a.dot(b.cross(c));
-  }
-  return v / 6.0;
-}
+using test::soup_volume;
 
 }  // namespace lamina::mesh_test

@@ -76,4 +76,13 @@ inline std::string structure_problem(const Mesh& m) {
   return {};
 }
 
+// build_mesh that must succeed and give a well-formed mesh (test failures otherwise).
+inline Mesh build_checked(const TriangleSoup& soup, const MeshParams& params = {}) {
+  auto r = build_mesh(soup, params);
+  EXPECT_TRUE(r.has_value()) << (r ? "" : r.error().message);
+  if (!r) return Mesh{};
+  EXPECT_EQ(structure_problem(*r), "");
+  return std::move(*r);
+}
+
 }  // namespace lamina::mesh_test
