@@ -10,6 +10,7 @@
 
 #include <chrono>
 #include <memory>
+#include <set>
 
 namespace lamina::cli {
 namespace {
@@ -25,8 +26,9 @@ struct SliceOptions {
   bool all_rows = false;
 };
 
-void print_table(const std::vector<Slice>& slices, bool all_rows) {
-  fmt::print("{:>10} {:>6} {:>6} {:>8} {:>14}  {}\n", "z mm", "outer", "holes", "vectors", "net area mm2", "notes");
+void print_table(const Mesh& mesh, const std::vector<Slice>& slices, bool all_rows) {
+  fmt::print("{:>10} {:>6} {:>6} {:>8} {:>9} {:>14}  {}\n", "z mm", "outer", "holes", "vectors", "surfaces",
+             "net area mm2", "notes");
   const std::size_t n = slices.size();
   const bool elide = !all_rows && n > 40;
   for (std::size_t i = 0; i < n; ++i) {
@@ -34,12 +36,17 @@ void print_table(const std::vector<Slice>& slices, bool all_rows) {
     if (elide && i >= 20 && i < n - 5) continue;
     const Slice& s = slices[i];
     std::size_t vectors = 0;
-    for (const Loop& l : s.loops) vectors += l.size();
+    std::set<std::int32_t> surfaces;  // how many CAD-like surfaces this section crosses
+    for (const Loop& l : s.loops) {
+      vectors += l.size();
+      for (const std::int32_t f : l.facets)
+        if (f >= 0) surfaces.insert(mesh.surface_id[static_cast<std::size_t>(f)]);
+    }
     std::string notes;
     if (!s.open_chains.empty()) notes += fmt::format("{} open chain(s); ", s.open_chains.size());
     for (const std::string& w : s.warnings) notes += w + "; ";
-    fmt::print("{:>10.4f} {:>6} {:>6} {:>8} {:>14.6g}  {}\n", s.z_mm, s.outer_count(), s.hole_count(), vectors,
-               s.net_area_mm2(), notes);
+    fmt::print("{:>10.4f} {:>6} {:>6} {:>8} {:>9} {:>14.6g}  {}\n", s.z_mm, s.outer_count(), s.hole_count(), vectors,
+               surfaces.size(), s.net_area_mm2(), notes);
   }
 }
 
@@ -98,7 +105,7 @@ void add_slice_command(CLI::App& app, int& exit_code) {
       exit_code = 1;
       return;
     }
-    print_table(*slices, o->all_rows);
+    print_table(model->mesh, *slices, o->all_rows);
     fmt::print("timing: read {:.3f} s, topology {:.3f} s, slice {:.3f} s ({} slices, {} triangles)\n",
                model->read_s, model->topology_s, slice_s, slices->size(), model->mesh.summary.triangles);
     if (!o->json_path.empty()) {
