@@ -1,12 +1,13 @@
 // Overlapping shells (CAD bodies exported as one file without a boolean union) must slice to the
-// union of the solids. The loops are split where loops of different shells cross; a piece stays
-// on the boundary iff the total winding number just to its right (its outside) is 0 while its left
-// is inside — i.e. the winding of all *other* loops at its midpoint, plus this loop's own winding
-// on its right (0 for CCW, -1 for CW), is exactly 0. Surviving pieces keep their facet, so the
-// contour vectors still know the facet normal and surface they came from.
+// union of the solids. The loops are split where loops meet (crossing, touching, or running along
+// each other where bodies touch face to face); a piece stays on the boundary iff the total winding
+// number just to its right (its outside) is 0 — its left is then inside. Of coincident pieces
+// facing the same way one is kept; coincident pieces facing each other (an internal wall) go.
+// Surviving pieces keep their facet, so the contour vectors still know the facet normal and surface they came from.
 #include "slice_internal.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 #include <set>
@@ -47,6 +48,12 @@ struct Hit {
   double t_o, t_cur;      // parameters along o and cur (0 or 1 at their own end points)
 };
 
+// Parameter of p along a → b (p on that line).
+double param(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& p) {
+  const Eigen::Vector2d d = b - a;
+  return (p - a).dot(d) / d.squaredNorm();
+}
+
 template <class PairOk, class Visit>
 void for_each_intersection(const std::vector<Seg>& segs, PairOk pair_ok, Visit visit) {
   std::vector<std::size_t> active;
@@ -62,7 +69,19 @@ void for_each_intersection(const std::vector<Seg>& segs, PairOk pair_ok, Visit v
       const double o1 = orient(cur.a, cur.b, o.a), o2 = orient(cur.a, cur.b, o.b);
       const double o3 = orient(o.a, o.b, cur.a), o4 = orient(o.a, o.b, cur.b);
       if ((o1 > 0 && o2 > 0) || (o1 < 0 && o2 < 0) || (o3 > 0 && o4 > 0) || (o3 < 0 && o4 < 0)) continue;
-      if (o1 == 0 && o2 == 0) continue;  // collinear
+      if (o1 == 0 && o2 == 0) {
+        // Collinear (walls of bodies touching face to face): every end point of one lying inside
+        // the other is a meeting point, so the overlap becomes whole, coincident pieces.
+        for (const Eigen::Vector2d* p : {&o.a, &o.b}) {
+          const double t = param(cur.a, cur.b, *p);
+          if (t > 0 && t < 1 && !stop) stop = !visit(o, cur, Hit{*p, p == &o.a ? 0.0 : 1.0, t});
+        }
+        for (const Eigen::Vector2d* p : {&cur.a, &cur.b}) {
+          const double t = param(o.a, o.b, *p);
+          if (t > 0 && t < 1 && !stop) stop = !visit(o, cur, Hit{*p, t, p == &cur.a ? 0.0 : 1.0});
+        }
+        continue;
+      }
       Hit h;
       h.t_o = o1 / (o1 - o2);
       h.t_cur = o3 / (o3 - o4);
@@ -125,7 +144,6 @@ std::vector<Loop> union_of_loops(const std::vector<Loop>& loops) {
   std::vector<Piece> kept;
   for (std::size_t l = 0; l < loops.size(); ++l) {
     const Loop& loop = loops[l];
-    const int own_right = loop.area_mm2 > 0.0 ? 0 : -1;
     std::vector<Piece> pieces;
     std::vector<std::size_t> run_start{0};  // a run is a stretch between meeting points
     const std::size_t n = loop.points.size();
@@ -149,13 +167,25 @@ std::vector<Loop> union_of_loops(const std::vector<Loop>& loops) {
       std::size_t probe = run_start[r];
       for (std::size_t k = run_start[r]; k < run_start[r + 1]; ++k)
         if ((pieces[k].b - pieces[k].a).squaredNorm() > (pieces[probe].b - pieces[probe].a).squaredNorm()) probe = k;
+      // Just right of the piece (its outside): the union's boundary has total winding 0 there.
+      // Off the piece itself, so a coincident wall of another body is on a definite side.
+      const Eigen::Vector2d d = pieces[probe].b - pieces[probe].a;
       const Eigen::Vector2d mid = 0.5 * (pieces[probe].a + pieces[probe].b);
-      int w = own_right;
-      for (std::size_t o = 0; o < loops.size(); ++o)
-        if (o != l) w += winding_number(loops[o], mid);
+      const double step = std::max(1e-9 * d.norm(), 1e-12 * (1.0 + mid.cwiseAbs().maxCoeff()));  // well above an ulp
+      const Eigen::Vector2d right = mid + step * Eigen::Vector2d(d.y(), -d.x()).normalized();
+      int w = 0;
+      for (std::size_t o = 0; o < loops.size(); ++o) w += winding_number(loops[o], right);
       if (w == 0)
         for (std::size_t k = run_start[r]; k < run_start[r + 1]; ++k) kept.push_back(pieces[k]);
     }
+  }
+  // Coincident walls facing the same way (two bodies flush on one side) survive twice: keep one.
+  {
+    std::set<std::array<double, 4>> seen;
+    std::vector<Piece> unique;
+    for (const Piece& p : kept)
+      if (seen.insert({p.a.x(), p.a.y(), p.b.x(), p.b.y()}).second) unique.push_back(p);
+    kept = std::move(unique);
   }
 
   // 3. Chain the kept pieces by exact end-point equality.
