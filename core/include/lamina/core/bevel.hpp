@@ -1,0 +1,98 @@
+#pragma once
+// The bevel plan of a layered part (paper 3-2 to 3-5): for every layer, its outlines, and on each
+// outline the cut passes a 5-axis jet makes. A pass is a ruled surface: a closed sequence of jet
+// lines (top point, bottom point), one per station of the outline.
+#include "lamina/core/bevel_profile.hpp"
+#include "lamina/core/error.hpp"
+#include "lamina/core/layering.hpp"
+#include "lamina/core/mesh.hpp"
+
+#include <Eigen/Core>
+
+#include <array>
+#include <cstdint>
+#include <expected>
+#include <span>
+#include <vector>
+
+namespace lamina {
+
+// One jet line through the sheet, with everything downstream needs about it.
+struct CutLine {
+  Eigen::Vector3d top_mm;       // where the line leaves the sheet's top face (z = layer top)
+  Eigen::Vector3d bottom_mm;    // where it leaves the bottom face (z = layer bottom)
+  Eigen::Vector3d tool_axis;    // unit, from the tool tip towards the nozzle (bottom → top)
+  double tilt_rad = 0.0;        // angle between tool axis and +Z, in [0, tilt_max]
+  double c_rad = 0.0;           // atan2 of the axis' XY part, unwound along the pass (no 2π jumps);
+                                // held from the previous line where tilt ≈ 0
+  // The paper's eq. 1, kept for reference: V = N × C (outer loops; C × N on holes, which it orders
+  // CCW too) is the surface tangent across the contour, pointing up; A = 180° − ∠(Z, V),
+  // C = ∠(X, V) in the XY plane, here from atan2 (signed, −180°…180°), not acos.
+  Eigen::Vector3d paper_v;      // unit; zero where the station has no facet behind it
+  double paper_a_deg = 0.0;
+  double paper_c_deg = 0.0;
+};
+
+// A point of a layer outline where the cuts are evaluated.
+struct CutStation {
+  Eigen::Vector2d base_mm;     // on the outline (the vertical "outside" edge: union of sub-slices)
+  Eigen::Vector2d normal;      // unit, horizontal, out of the material
+  ProfileShape shape = ProfileShape::empty;
+  bool slope_rule_agrees = true;
+  bool tilt_limited = false;
+  std::int32_t surface_id = -1;  // surface of the model the top-most sample lies on
+  double max_deviation_mm = 0.0;
+};
+
+struct CutPass {
+  std::vector<CutLine> lines;  // one per station, same order; the pass is closed (last → first)
+};
+
+// One closed outline of a layer: an outer boundary (CCW) or a hole (CW).
+struct LayerOutline {
+  bool is_hole = false;
+  int parent = -1;                    // for a hole: index of its outer outline in the layer
+  std::vector<CutStation> stations;
+  // Trim passes first, the pass that frees the part last. Every pass has one line per station.
+  std::vector<CutPass> passes;
+  double max_deviation_mm = 0.0;
+};
+
+struct LayerPlan {
+  int index = 0;
+  double z_bottom_mm = 0.0;
+  double thickness_mm = 0.0;
+  std::vector<double> sub_slice_z_mm;   // the thin slices the layer's profiles were read from
+  std::vector<LayerOutline> outlines;   // outers and their holes (parent links)
+  int passes = 0;                       // largest pass count of its outlines
+  double max_deviation_mm = 0.0;        // largest station deviation (profile plane), mm
+  bool within_tolerance = true;
+  // Stations per shape, indexed by ProfileShape.
+  std::array<int, 5> shape_counts{};
+
+  double z_top_mm() const { return z_bottom_mm + thickness_mm; }
+};
+
+struct BevelParams {
+  ProfileFitParams fit;
+  double sub_slice_mm = 0.5;        // spacing of the thin slices inside a layer (paper's thin layers)
+  double station_spacing_mm = 1.0;  // outline edges longer than this get extra stations
+  double tolerance_mm = 0.1;        // within_tolerance threshold for max_deviation_mm
+  bool parallel = true;             // layers on several threads (TBB); results do not depend on it
+};
+
+struct BevelPlan {
+  std::vector<LayerPlan> layers;
+  ProfileFitParams fit;
+};
+
+// Plan the cuts of every layer. Layers must be non-overlapping and in increasing z.
+std::expected<BevelPlan, Error> plan_bevels(const Mesh& mesh, std::span<const LayerSpan> layers,
+                                            const BevelParams& params);
+
+// The sub-slice heights of a layer: both faces nudged 1 µm inwards (so flat faces of the model
+// that coincide with a layer face are read from the right side) and evenly spaced inner slices
+// no further apart than sub_slice_mm.
+std::vector<double> sub_slice_heights(double z_bottom_mm, double thickness_mm, double sub_slice_mm);
+
+}  // namespace lamina

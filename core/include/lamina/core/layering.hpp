@@ -1,0 +1,59 @@
+#pragma once
+// Adaptive layers from stock (paper 3-1): which sheet thickness each layer of the stack is cut
+// from. The paper's greedy rule is kept as a baseline; the default is a dynamic programme over a
+// z grid that minimises the number of layers subject to each layer's *achievable* deviation
+// (after bevelling, at the tilt limit) being within tolerance.
+#include "lamina/core/bevel_profile.hpp"
+#include "lamina/core/error.hpp"
+#include "lamina/core/mesh.hpp"
+
+#include <cstdint>
+#include <expected>
+#include <string>
+#include <vector>
+
+namespace lamina {
+
+enum class LayeringMethod : std::uint8_t { optimal, greedy };
+const char* layering_method_name(LayeringMethod method);
+
+struct LayeringParams {
+  std::vector<double> thicknesses_mm;  // stock thicknesses available (any order, > 0)
+  double bond_mm = 0.0;                // bonding gap between consecutive layers (adhesive)
+  double sub_slice_mm = 0.5;           // z grid of the thin slices
+  double tolerance_mm = 0.1;           // allowed achievable deviation per layer (optimal)
+  LayeringMethod method = LayeringMethod::optimal;
+  ProfileFitParams fit;                // how layers will be bevelled (side, strategy, tilt limit)
+  // Greedy (paper): split while the area deviation between a layer's top and bottom contours
+  // exceeds this fraction, or the staircase triangle (½·thickness·horizontal step between top
+  // and bottom at a station) exceeds the allowed area (the paper's form: 0.005 in²).
+  double greedy_area_deviation = 0.15;
+  double greedy_triangle_area_mm2 = 3.2258;
+  bool parallel = true;
+};
+
+struct LayerSpan {
+  double z_bottom_mm = 0.0;
+  double thickness_mm = 0.0;
+  double estimated_deviation_mm = 0.0;  // the layering's own (grid) estimate of the achievable deviation
+  bool within_tolerance = true;         // the estimate met the tolerance (optimal) / criteria (greedy)
+  double z_top_mm() const { return z_bottom_mm + thickness_mm; }
+};
+
+// A z range where no stock thickness met the tolerance: the thinnest was used there.
+struct Shortfall {
+  double z_from_mm = 0.0, z_to_mm = 0.0;
+  double deviation_mm = 0.0;  // the deviation reached with the thinnest sheet
+};
+
+struct Layering {
+  std::vector<LayerSpan> layers;        // bottom to top; layer i+1 starts bond_mm above layer i's top
+  double model_height_mm = 0.0;
+  double stack_height_mm = 0.0;         // sheets + bonds: top of the last layer
+  std::vector<Shortfall> shortfalls;
+  std::vector<std::string> warnings;
+};
+
+std::expected<Layering, Error> choose_layers(const Mesh& mesh, const LayeringParams& params);
+
+}  // namespace lamina

@@ -1,0 +1,68 @@
+#pragma once
+// Line queries against one slice: where does a horizontal line cross the section's boundary?
+// Used to find the corresponding points of a station on every sub-slice of a layer (paper 3-4:
+// "a line parallel to the projected vector … intersected with a short list of line segments").
+#include "lamina/core/mesh.hpp"
+#include "lamina/core/slice.hpp"
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+namespace lamina {
+
+struct LineCrossing {
+  double u_mm = 0.0;            // position along the line: origin + u·direction
+  Eigen::Vector3d normal;       // unit facet normal of the contour vector crossed
+  std::int32_t surface_id = -1;
+  std::int32_t facet = -1;
+};
+
+enum class CrossingPick : std::uint8_t {
+  largest,       // the exit crossing with the largest u in range (first met walking in from u_max)
+  nearest_zero,  // the exit crossing with the smallest |u| in range
+};
+
+// A uniform grid over one slice's contour vectors. Cheap to build (linear in the slice size),
+// immutable afterwards, safe to query from several threads.
+class SectionLines {
+ public:
+  SectionLines() = default;
+  SectionLines(const Mesh& mesh, const Slice& slice);
+
+  double z_mm() const { return z_mm_; }
+  bool empty() const { return segments_.empty(); }
+
+  // Exit crossings of the line origin + u·direction (direction: unit, horizontal) with u in
+  // [u_min, u_max]: places where, walking towards +u, one leaves the material. Material is on
+  // the left of every loop vector (outer loops CCW, holes CW), so this is independent of which
+  // loop is crossed.
+  std::optional<LineCrossing> exit_crossing(const Eigen::Vector2d& origin, const Eigen::Vector2d& direction,
+                                            double u_min, double u_max, CrossingPick pick) const;
+
+  // True when p lies inside the section's material (even-odd over all loops).
+  bool contains(const Eigen::Vector2d& p) const;
+
+ private:
+  struct Segment {
+    Eigen::Vector2d a, b;
+    Eigen::Vector3d normal;
+    std::int32_t surface_id, facet;
+  };
+  double z_mm_ = 0.0;
+  std::vector<Segment> segments_;
+  Eigen::Vector2d origin_{0, 0};
+  double cell_mm_ = 1.0;
+  int nx_ = 0, ny_ = 0;
+  std::vector<std::uint32_t> cell_begin_;  // CSR: cell → segment indices
+  std::vector<std::uint32_t> cell_items_;
+};
+
+// du/dz of a surface with unit normal `normal` in the vertical plane along the horizontal unit
+// direction `direction`: the facet plane's trace in the profile plane. Clamped to ±1e6
+// (horizontal facets).
+double profile_slope(const Eigen::Vector3d& normal, const Eigen::Vector2d& direction);
+
+}  // namespace lamina

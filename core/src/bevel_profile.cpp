@@ -1,0 +1,380 @@
+// Cut lines for one station's profile (paper 3-3 to 3-5), and how far they leave the surface.
+// Conventions in bevel_profile.hpp: u along the outward normal, material at u < surface, several
+// cuts keep the minimum of their lines.
+#include "lamina/core/bevel_profile.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace lamina {
+
+const char* cut_side_name(CutSide side) {
+  switch (side) {
+    case CutSide::outside: return "outside";
+    case CutSide::inside: return "inside";
+    case CutSide::mixed: return "mixed";
+  }
+  return "?";
+}
+
+const char* bevel_strategy_name(BevelStrategy strategy) {
+  switch (strategy) {
+    case BevelStrategy::curved: return "curved";
+    case BevelStrategy::sloped: return "sloped";
+    case BevelStrategy::vertical: return "vertical";
+  }
+  return "?";
+}
+
+const char* profile_shape_name(ProfileShape shape) {
+  switch (shape) {
+    case ProfileShape::straight: return "straight";
+    case ProfileShape::convex: return "convex";
+    case ProfileShape::concave: return "concave";
+    case ProfileShape::mixed: return "mixed";
+    case ProfileShape::empty: return "empty";
+  }
+  return "?";
+}
+
+namespace {
+
+struct Point {
+  double z, u;
+};
+
+// A line u = c + m·(z − z_bottom).
+struct Line {
+  double c, m;
+  double at(double z, double z_bottom) const { return c + m * (z - z_bottom); }
+};
+
+class Fitter {
+ public:
+  Fitter(std::span<const ProfileSample> samples, double z_bottom, double z_top, const ProfileFitParams& params)
+      : all_(samples), zb_(z_bottom), zt_(z_top), params_(params) {
+    tan_max_ = params.tilt_max_rad >= 0.5 * M_PI - 1e-9 ? 1e12 : std::tan(params.tilt_max_rad);
+    for (const auto& s : samples) {
+      if (s.present && std::isfinite(s.u_mm)) present_.push_back({s.z_mm, s.u_mm});
+    }
+  }
+
+  ProfileFit run() {
+    ProfileFit fit;
+    if (present_.empty()) return fit;  // shape empty, no cut: nothing of the part on this line
+    classify(fit);
+    std::vector<Line> lines = choose_lines(fit);
+    fit.cuts.reserve(lines.size());
+    for (const Line& l : lines) fit.cuts.push_back({l.at(zb_, zb_), l.at(zt_, zb_)});
+    fit.max_deviation_mm = deviation(lines);
+    return fit;
+  }
+
+ private:
+  double clamp_slope(double m) {
+    if (!std::isfinite(m)) m = m > 0 ? tan_max_ : -tan_max_;
+    if (std::abs(m) > tan_max_) {
+      limited_ = true;
+      return std::copysign(tan_max_, m);
+    }
+    return m;
+  }
+
+  // Slope of the surface at sample i of all_: the facet's tangent, or a finite difference where
+  // the sample carries none.
+  double sample_slope(std::size_t i) const {
+    if (std::isfinite(all_[i].slope)) return all_[i].slope;
+    return chord_slope_;
+  }
+
+  double chord_at(double z) const { return present_.front().u + chord_slope_ * (z - present_.front().z); }
+
+  void classify(ProfileFit& fit) {
+    const Point& a = present_.front();
+    const Point& b = present_.back();
+    if (present_.size() >= 2 && b.z - a.z > 1e-12) {
+      chord_slope_ = (b.u - a.u) / (b.z - a.z);
+    } else {
+      // One sample: the surface's own tangent is all we know.
+      chord_slope_ = 0.0;
+      for (const auto& s : all_) {
+        if (s.present && std::isfinite(s.slope)) { chord_slope_ = s.slope; break; }
+      }
+    }
+    const double tol = params_.straight_tolerance_mm;
+    bool above = false, below = false;  // some sample bulges beyond / stays behind the chord
+    for (const Point& p : present_) {
+      const double d = p.u - chord_at(p.z);
+      above |= d > tol;
+      below |= d < -tol;
+    }
+    fit.shape = above && below ? ProfileShape::mixed
+              : above          ? ProfileShape::convex
+              : below          ? ProfileShape::concave
+                               : ProfileShape::straight;
+    // The paper's rule: convex when the tangent at the bottom (θ) leans out more than higher up
+    // (β), i.e. du/dz decreases upwards.
+    if (fit.shape == ProfileShape::convex || fit.shape == ProfileShape::concave) {
+      double first = std::numeric_limits<double>::quiet_NaN(), last = first;
+      for (std::size_t i = 0; i < all_.size(); ++i) {
+        if (!all_[i].present || !std::isfinite(all_[i].slope)) continue;
+        if (std::isnan(first)) first = all_[i].slope;
+        last = all_[i].slope;
+      }
+      if (std::isfinite(first) && std::isfinite(last)) {
+        const bool slope_says_convex = first > last;
+        fit.slope_rule_agrees = slope_says_convex == (fit.shape == ProfileShape::convex);
+      }
+    }
+    shape_ = fit.shape;
+  }
+
+  // The line of slope m through the outermost (outside) / innermost (inside) sample.
+  Line support_above(double m) const {
+    double c = -std::numeric_limits<double>::infinity();
+    for (const Point& p : present_) c = std::max(c, p.u - m * (p.z - zb_));
+    return {c, m};
+  }
+  Line support_below(double m) const {
+    double c = std::numeric_limits<double>::infinity();
+    for (const Point& p : present_) c = std::min(c, p.u - m * (p.z - zb_));
+    return {c, m};
+  }
+  // Chebyshev: the line of slope m centred between the samples.
+  Line centred(double m, double* half_width) const {
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (const Point& p : present_) {
+      const double r = p.u - m * (p.z - zb_);
+      lo = std::min(lo, r);
+      hi = std::max(hi, r);
+    }
+    if (half_width) *half_width = 0.5 * (hi - lo);
+    return {0.5 * (hi + lo), m};
+  }
+
+  // Candidate slopes for a single best line: the chord, the surface tangents, and the slopes
+  // between every pair of samples (the hull edges are among them).
+  std::vector<double> candidate_slopes() {
+    std::vector<double> ms{chord_slope_};
+    for (std::size_t i = 0; i < all_.size(); ++i) {
+      if (all_[i].present && std::isfinite(all_[i].slope)) ms.push_back(all_[i].slope);
+    }
+    for (std::size_t i = 0; i < present_.size(); ++i) {
+      for (std::size_t j = i + 1; j < present_.size(); ++j) {
+        const double dz = present_[j].z - present_[i].z;
+        if (dz > 1e-12) ms.push_back((present_[j].u - present_[i].u) / dz);
+      }
+    }
+    for (double& m : ms) m = clamp_slope(m);
+    return ms;
+  }
+
+  // One supporting line (outside: above every sample; inside: below) with the smallest gap.
+  Line best_support(bool above) {
+    Line best{0, 0};
+    double best_gap = std::numeric_limits<double>::infinity();
+    const bool was_limited = limited_;
+    bool best_limited = false;
+    for (double m : candidate_slopes()) {
+      limited_ = false;
+      const double mm = clamp_slope(m);
+      const Line l = above ? support_above(mm) : support_below(mm);
+      double gap = 0;
+      for (const Point& p : present_) gap = std::max(gap, std::abs(l.at(p.z, zb_) - p.u));
+      if (gap < best_gap - 1e-12) {
+        best_gap = gap;
+        best = l;
+        best_limited = std::abs(mm) >= tan_max_ * (1 - 1e-12) && std::abs(m) >= tan_max_;
+      }
+    }
+    limited_ = was_limited || best_limited;
+    return best;
+  }
+
+  std::vector<Line> choose_lines(ProfileFit& fit) {
+    std::vector<Line> lines;
+    const auto& st = params_.strategy;
+    const auto& side = params_.side;
+    const bool curved = st == BevelStrategy::curved;
+    if (side == CutSide::mixed) {
+      const double m = st == BevelStrategy::vertical ? 0.0 : clamp_slope(chord_slope_);
+      lines.push_back(centred(m, nullptr));
+    } else if (st == BevelStrategy::vertical) {
+      lines.push_back(side == CutSide::outside ? support_above(0.0) : support_below(0.0));
+    } else if (side == CutSide::outside) {
+      if (curved && shape_ == ProfileShape::convex) {
+        lines = per_sample_lines([&](std::size_t i) {
+          return support_above(clamp_slope(sample_slope(i)));  // the tangent there (raised if clamped)
+        });
+      } else if (curved && shape_ == ProfileShape::mixed) {
+        lines.push_back(best_support(true));
+      } else {
+        lines.push_back(support_above(clamp_slope(chord_slope_)));  // concave/straight: the chord
+      }
+    } else {  // inside
+      if (curved && shape_ == ProfileShape::convex) {
+        // Chords of neighbouring samples: their intersection is the inscribed polyline.
+        lines = per_sample_lines([&](std::size_t i) { return chord_line_after(i); });
+      } else if (curved && (shape_ == ProfileShape::mixed || shape_ == ProfileShape::concave)) {
+        lines.push_back(best_support(false));
+      } else {
+        lines.push_back(support_below(clamp_slope(chord_slope_)));
+      }
+    }
+    fit.tilt_limited = limited_;
+    return lines;
+  }
+
+  // One line per sample of all_ (so passes line up across stations); samples without material
+  // take the line of the nearest sample with material.
+  template <class MakeLine>
+  std::vector<Line> per_sample_lines(MakeLine make) {
+    std::vector<Line> lines(all_.size());
+    std::vector<int> nearest(all_.size(), -1);
+    int last = -1;
+    for (std::size_t i = 0; i < all_.size(); ++i) {
+      if (all_[i].present && std::isfinite(all_[i].u_mm)) last = static_cast<int>(i);
+      nearest[i] = last;
+    }
+    int next = -1;
+    for (std::size_t k = all_.size(); k-- > 0;) {
+      if (all_[k].present && std::isfinite(all_[k].u_mm)) next = static_cast<int>(k);
+      if (nearest[k] < 0 || (next >= 0 && next - static_cast<int>(k) < static_cast<int>(k) - nearest[k])) nearest[k] = next;
+    }
+    for (std::size_t i = 0; i < all_.size(); ++i) {
+      if (nearest[i] == static_cast<int>(i)) lines[i] = make(i);
+    }
+    for (std::size_t i = 0; i < all_.size(); ++i) lines[i] = lines[static_cast<std::size_t>(nearest[i])];
+    return lines;
+  }
+
+  // Inside multi-cut: the chord from sample i to the next sample with material (the last one
+  // takes the chord before it), its slope held at the tilt limit.
+  Line chord_line_after(std::size_t i) {
+    std::size_t j = i + 1;
+    while (j < all_.size() && !all_[j].present) ++j;
+    std::size_t a = i, b = j;
+    if (j >= all_.size()) {
+      b = i;
+      a = i;
+      while (a > 0 && (a == i || !all_[a].present)) --a;
+      if (a == i || !all_[a].present) return support_below(clamp_slope(chord_slope_));
+    }
+    const double dz = all_[b].z_mm - all_[a].z_mm;
+    const double m = clamp_slope(dz > 1e-12 ? (all_[b].u_mm - all_[a].u_mm) / dz : chord_slope_);
+    const double c = all_[a].u_mm - m * (all_[a].z_mm - zb_);
+    return {c, m};
+  }
+
+  // Largest distance in the profile plane between the cut edge and the surface, both ways.
+  double deviation(const std::vector<Line>& lines) const {
+    auto edge = [&](double z) {
+      double u = std::numeric_limits<double>::infinity();
+      for (const Line& l : lines) u = std::min(u, l.at(z, zb_));
+      return u;
+    };
+    // The edge as a polyline: layer faces and sample heights, plus the corner where the active
+    // line changes between two of them (O(heights × lines), not all pairs of lines).
+    std::vector<double> zs{zb_, zt_};
+    for (const auto& s : all_) zs.push_back(std::clamp(s.z_mm, zb_, zt_));
+    std::sort(zs.begin(), zs.end());
+    zs.erase(std::unique(zs.begin(), zs.end(), [](double a, double b) { return std::abs(a - b) < 1e-12; }), zs.end());
+    auto active = [&](double z) {
+      std::size_t best = 0;
+      for (std::size_t i = 1; i < lines.size(); ++i) {
+        if (lines[i].at(z, zb_) < lines[best].at(z, zb_)) best = i;
+      }
+      return best;
+    };
+    std::vector<Point> edge_pts;
+    edge_pts.reserve(2 * zs.size());
+    std::size_t prev = lines.size();
+    for (double z : zs) {
+      const std::size_t a = active(z);
+      if (prev < lines.size() && a != prev) {
+        const double dm = lines[prev].m - lines[a].m;
+        if (std::abs(dm) > 1e-12) {
+          const double zc = zb_ + (lines[a].c - lines[prev].c) / dm;
+          if (zc > edge_pts.back().z && zc < z) edge_pts.push_back({zc, edge(zc)});
+        }
+      }
+      edge_pts.push_back({z, edge(z)});
+      prev = a;
+    }
+
+    // The surface as segments: neighbouring samples with material joined; where material stops
+    // (the surface turned horizontal between two sub-slices) a ledge runs inwards half-way.
+    struct Seg { Point a, b; };
+    std::vector<Seg> surface;
+    constexpr double kInward = 1e6;
+    for (std::size_t i = 0; i < all_.size(); ++i) {
+      const auto& s = all_[i];
+      if (!s.present) continue;
+      const Point p{s.z_mm, s.u_mm};
+      if (i + 1 < all_.size()) {
+        const auto& n = all_[i + 1];
+        if (n.present) {
+          surface.push_back({p, {n.z_mm, n.u_mm}});
+        } else {
+          const double zh = 0.5 * (s.z_mm + n.z_mm);
+          surface.push_back({p, {zh, s.u_mm}});
+          surface.push_back({{zh, s.u_mm}, {zh, s.u_mm - kInward}});
+        }
+      }
+      if (i > 0 && !all_[i - 1].present) {
+        const double zh = 0.5 * (s.z_mm + all_[i - 1].z_mm);
+        surface.push_back({p, {zh, s.u_mm}});
+        surface.push_back({{zh, s.u_mm}, {zh, s.u_mm - kInward}});
+      }
+      if (present_.size() == 1) surface.push_back({p, p});
+    }
+    auto dist_to_seg = [](const Point& p, const Point& a, const Point& b) {
+      const double dz = b.z - a.z, du = b.u - a.u;
+      const double len2 = dz * dz + du * du;
+      double t = len2 > 0 ? ((p.z - a.z) * dz + (p.u - a.u) * du) / len2 : 0.0;
+      t = std::clamp(t, 0.0, 1.0);
+      const double ez = a.z + t * dz - p.z, eu = a.u + t * du - p.u;
+      return std::sqrt(ez * ez + eu * eu);
+    };
+    double worst = 0.0;
+    for (const Point& e : edge_pts) {
+      double best = std::numeric_limits<double>::infinity();
+      for (const Seg& s : surface) best = std::min(best, dist_to_seg(e, s.a, s.b));
+      if (std::isfinite(best)) worst = std::max(worst, best);
+    }
+    for (const Point& p : present_) {
+      double best = std::numeric_limits<double>::infinity();
+      for (std::size_t i = 0; i + 1 < edge_pts.size(); ++i) best = std::min(best, dist_to_seg(p, edge_pts[i], edge_pts[i + 1]));
+      if (edge_pts.size() == 1) best = dist_to_seg(p, edge_pts[0], edge_pts[0]);
+      worst = std::max(worst, best);
+    }
+    return worst;
+  }
+
+  std::span<const ProfileSample> all_;
+  double zb_, zt_;
+  ProfileFitParams params_;
+  double tan_max_ = 0.0;
+  std::vector<Point> present_;
+  double chord_slope_ = 0.0;
+  ProfileShape shape_ = ProfileShape::empty;
+  bool limited_ = false;
+};
+
+}  // namespace
+
+ProfileFit fit_profile(std::span<const ProfileSample> samples, double z_bottom_mm, double z_top_mm,
+                       const ProfileFitParams& params) {
+  return Fitter(samples, z_bottom_mm, z_top_mm, params).run();
+}
+
+double cut_edge_at(const ProfileFit& fit, double z_mm, double z_bottom_mm, double z_top_mm) {
+  const double span = z_top_mm - z_bottom_mm;
+  const double t = span > 0 ? (z_mm - z_bottom_mm) / span : 0.0;
+  double u = std::numeric_limits<double>::infinity();
+  for (const auto& c : fit.cuts) u = std::min(u, c.u_bottom_mm + t * (c.u_top_mm - c.u_bottom_mm));
+  return u;
+}
+
+}  // namespace lamina

@@ -1,0 +1,22 @@
+#pragma once
+// Private: between our polygons (double mm) and Clipper 6's integer paths. One scale for the
+// whole library: 1 unit = 1 nm, so ±4.6e9 m of range and far below any mesh's float precision.
+#include "lamina/core/polygon.hpp"
+
+#include <polyclipping/clipper.hpp>
+
+#include <vector>
+
+namespace lamina::detail {
+
+inline constexpr double kClipperUnitsPerMm = 1e6;
+
+ClipperLib::Path to_clipper(const Polygon2& ring);
+ClipperLib::Paths to_clipper(const std::vector<Polygon2>& rings);
+Polygon2 from_clipper(const ClipperLib::Path& path);
+std::vector<Polygon2> from_clipper(const ClipperLib::Paths& paths);
+
+// Net signed area of paths in mm² (holes count negative).
+double area_mm2(const ClipperLib::Paths& paths);
+
+}  // namespace lamina::detail

@@ -1,0 +1,192 @@
+// Line queries against one slice through a uniform grid of its contour vectors. The paper finds
+// corresponding points by intersecting a line with "a short list of line segments"; the grid is
+// that short list.
+#include "lamina/core/section_lines.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace lamina {
+
+namespace {
+double cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a.x() * b.y() - a.y() * b.x(); }
+}  // namespace
+
+double profile_slope(const Eigen::Vector3d& normal, const Eigen::Vector2d& direction) {
+  // The facet plane n·x = 0 traced in the plane spanned by (direction, z): n_h·d·u + n_z·z = 0.
+  constexpr double kSteep = 1e6;
+  const double nd = normal.x() * direction.x() + normal.y() * direction.y();
+  const double nz = normal.z();
+  if (std::abs(nz) < 1e-15) return 0.0;
+  if (std::abs(nd) * kSteep <= std::abs(nz)) return nd * nz > 0 ? -kSteep : kSteep;
+  return -nz / nd;
+}
+
+SectionLines::SectionLines(const Mesh& mesh, const Slice& slice) : z_mm_(slice.z_mm) {
+  std::size_t n = 0;
+  for (const auto& l : slice.loops) n += l.size();
+  segments_.reserve(n);
+  Eigen::Vector2d lo(std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity());
+  Eigen::Vector2d hi = -lo;
+  for (const auto& l : slice.loops) {
+    const std::size_t m = l.size();
+    for (std::size_t i = 0; i < m; ++i) {
+      Segment s;
+      s.a = l.points[i];
+      s.b = l.points[(i + 1) % m];
+      s.facet = l.facets[i];
+      if (s.facet >= 0) {
+        s.normal = mesh.normals[static_cast<std::size_t>(s.facet)];
+        s.surface_id = mesh.surface_id[static_cast<std::size_t>(s.facet)];
+      } else {
+        const Eigen::Vector2d d = (s.b - s.a).normalized();
+        s.normal = Eigen::Vector3d(d.y(), -d.x(), 0.0);
+        s.surface_id = -1;
+      }
+      lo = lo.cwiseMin(s.a).cwiseMin(s.b);
+      hi = hi.cwiseMax(s.a).cwiseMax(s.b);
+      segments_.push_back(s);
+    }
+  }
+  if (segments_.empty()) return;
+  // About one segment per cell on average: contours are long thin sets, so use the extent.
+  const Eigen::Vector2d size = (hi - lo).cwiseMax(1e-9);
+  const double cells_wanted = std::max<double>(1.0, static_cast<double>(segments_.size()));
+  cell_mm_ = std::max(std::sqrt(size.x() * size.y() / cells_wanted), std::max(size.x(), size.y()) / 4096.0);
+  cell_mm_ = std::max(cell_mm_, 1e-6);
+  nx_ = std::max(1, static_cast<int>(std::ceil(size.x() / cell_mm_)));
+  ny_ = std::max(1, static_cast<int>(std::ceil(size.y() / cell_mm_)));
+  origin_ = lo;
+
+  auto cell_range = [&](const Segment& s, int& x0, int& x1, int& y0, int& y1) {
+    const Eigen::Vector2d a = (s.a.cwiseMin(s.b) - origin_) / cell_mm_;
+    const Eigen::Vector2d b = (s.a.cwiseMax(s.b) - origin_) / cell_mm_;
+    x0 = std::clamp(static_cast<int>(std::floor(a.x())), 0, nx_ - 1);
+    x1 = std::clamp(static_cast<int>(std::floor(b.x())), 0, nx_ - 1);
+    y0 = std::clamp(static_cast<int>(std::floor(a.y())), 0, ny_ - 1);
+    y1 = std::clamp(static_cast<int>(std::floor(b.y())), 0, ny_ - 1);
+  };
+  const std::size_t cells = static_cast<std::size_t>(nx_) * static_cast<std::size_t>(ny_);
+  cell_begin_.assign(cells + 1, 0);
+  for (const auto& s : segments_) {
+    int x0, x1, y0, y1;
+    cell_range(s, x0, x1, y0, y1);
+    for (int y = y0; y <= y1; ++y)
+      for (int x = x0; x <= x1; ++x) ++cell_begin_[static_cast<std::size_t>(y) * nx_ + x + 1];
+  }
+  for (std::size_t c = 0; c < cells; ++c) cell_begin_[c + 1] += cell_begin_[c];
+  cell_items_.resize(cell_begin_.back());
+  std::vector<std::uint32_t> fill(cell_begin_.begin(), cell_begin_.end() - 1);
+  for (std::uint32_t i = 0; i < segments_.size(); ++i) {
+    int x0, x1, y0, y1;
+    cell_range(segments_[i], x0, x1, y0, y1);
+    for (int y = y0; y <= y1; ++y)
+      for (int x = x0; x <= x1; ++x) cell_items_[fill[static_cast<std::size_t>(y) * nx_ + x]++] = i;
+  }
+}
+
+std::optional<LineCrossing> SectionLines::exit_crossing(const Eigen::Vector2d& origin, const Eigen::Vector2d& direction,
+                                                        double u_min, double u_max, CrossingPick pick) const {
+  if (segments_.empty() || !(u_max >= u_min)) return std::nullopt;
+  // Clip the query to the grid's box (slab test), then walk its cells (Amanatides & Woo).
+  double t0 = u_min, t1 = u_max;
+  const Eigen::Vector2d box_lo = origin_;
+  const Eigen::Vector2d box_hi = origin_ + Eigen::Vector2d(nx_, ny_) * cell_mm_;
+  for (int k = 0; k < 2; ++k) {
+    if (std::abs(direction[k]) < 1e-300) {
+      if (origin[k] < box_lo[k] || origin[k] > box_hi[k]) return std::nullopt;
+      continue;
+    }
+    double a = (box_lo[k] - origin[k]) / direction[k];
+    double b = (box_hi[k] - origin[k]) / direction[k];
+    if (a > b) std::swap(a, b);
+    t0 = std::max(t0, a);
+    t1 = std::min(t1, b);
+  }
+  if (t0 > t1) return std::nullopt;
+
+  const Eigen::Vector2d start = (origin + t0 * direction - origin_) / cell_mm_;
+  int cx = std::clamp(static_cast<int>(std::floor(start.x())), 0, nx_ - 1);
+  int cy = std::clamp(static_cast<int>(std::floor(start.y())), 0, ny_ - 1);
+  const int step_x = direction.x() > 0 ? 1 : -1;
+  const int step_y = direction.y() > 0 ? 1 : -1;
+  const double inf = std::numeric_limits<double>::infinity();
+  const double dt_x = std::abs(direction.x()) > 1e-300 ? cell_mm_ / std::abs(direction.x()) : inf;
+  const double dt_y = std::abs(direction.y()) > 1e-300 ? cell_mm_ / std::abs(direction.y()) : inf;
+  auto boundary_t = [&](int c, int step, int k) {
+    if (std::abs(direction[k]) < 1e-300) return inf;
+    const double edge = origin_[k] + (c + (step > 0 ? 1 : 0)) * cell_mm_;
+    return (edge - origin[k]) / direction[k];
+  };
+  double next_x = boundary_t(cx, step_x, 0);
+  double next_y = boundary_t(cy, step_y, 1);
+
+  std::optional<LineCrossing> best;
+  double best_key = inf;
+  std::uint32_t seen[64];
+  int seen_count = 0;
+  auto consider = [&](std::uint32_t idx) {
+    for (int i = 0; i < seen_count; ++i) {
+      if (seen[i] == idx) return;
+    }
+    if (seen_count < 64) seen[seen_count++] = idx;
+    const Segment& s = segments_[idx];
+    const Eigen::Vector2d e = s.b - s.a;
+    const double denom = cross(direction, e);
+    if (std::abs(denom) < 1e-300) return;
+    const Eigen::Vector2d w = s.a - origin;
+    const double u = cross(w, e) / denom;
+    const double t = cross(w, direction) / denom;
+    if (t < 0.0 || t >= 1.0 || u < u_min || u > u_max) return;
+    // Material is on the left of e; leaving it towards +u means the left side faces −direction.
+    const Eigen::Vector2d left(-e.y(), e.x());
+    if (left.dot(direction) >= 0.0) return;
+    const double key = pick == CrossingPick::largest ? -u : std::abs(u);
+    if (key < best_key) {
+      best_key = key;
+      best = LineCrossing{u, s.normal, s.surface_id, s.facet};
+    }
+  };
+  while (true) {
+    const std::size_t c = static_cast<std::size_t>(cy) * nx_ + cx;
+    for (std::uint32_t k = cell_begin_[c]; k < cell_begin_[c + 1]; ++k) consider(cell_items_[k]);
+    if (seen_count >= 64) seen_count = 0;  // long walks: forget old ones (re-testing is harmless)
+    const double t_exit = std::min(next_x, next_y);
+    if (t_exit > t1) break;
+    if (next_x < next_y) {
+      cx += step_x;
+      next_x += dt_x;
+      if (cx < 0 || cx >= nx_) break;
+    } else {
+      cy += step_y;
+      next_y += dt_y;
+      if (cy < 0 || cy >= ny_) break;
+    }
+  }
+  return best;
+}
+
+bool SectionLines::contains(const Eigen::Vector2d& p) const {
+  if (segments_.empty()) return false;
+  const Eigen::Vector2d g = (p - origin_) / cell_mm_;
+  const int cy = static_cast<int>(std::floor(g.y()));
+  if (cy < 0 || cy >= ny_ || g.x() >= nx_) return false;
+  const int cx0 = std::max(0, static_cast<int>(std::floor(g.x())));
+  // Count crossings of the ray +x from p, each segment once (it may sit in several cells).
+  std::vector<std::uint32_t> hits;
+  for (int cx = cx0; cx < nx_; ++cx) {
+    const std::size_t c = static_cast<std::size_t>(cy) * nx_ + cx;
+    for (std::uint32_t k = cell_begin_[c]; k < cell_begin_[c + 1]; ++k) {
+      const Segment& s = segments_[cell_items_[k]];
+      if ((s.a.y() > p.y()) == (s.b.y() > p.y())) continue;
+      const double x = s.a.x() + (p.y() - s.a.y()) * (s.b.x() - s.a.x()) / (s.b.y() - s.a.y());
+      if (x > p.x()) hits.push_back(cell_items_[k]);
+    }
+  }
+  std::sort(hits.begin(), hits.end());
+  const auto count = std::unique(hits.begin(), hits.end()) - hits.begin();
+  return (count % 2) == 1;
+}
+
+}  // namespace lamina
