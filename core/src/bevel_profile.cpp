@@ -58,6 +58,19 @@ class Fitter {
     for (const auto& s : samples) {
       if (s.present && std::isfinite(s.u_mm)) present_.push_back({s.z_mm, s.u_mm});
     }
+    // Between two samples a surface bulging out can pass beyond a line that only clears the
+    // samples. Where the tangents are known, the point where neighbouring tangents meet bounds
+    // the bulge; outside lines clear those corners too.
+    bounds_ = present_;
+    for (std::size_t i = 0; i + 1 < samples.size(); ++i) {
+      const auto& a = samples[i];
+      const auto& b = samples[i + 1];
+      if (!a.present || !b.present || !std::isfinite(a.slope) || !std::isfinite(b.slope)) continue;
+      const double dm = a.slope - b.slope;
+      if (dm <= 1e-12) continue;  // not bending back: the chord already bounds it
+      const double z = a.z_mm + (b.u_mm - a.u_mm - b.slope * (b.z_mm - a.z_mm)) / dm;
+      if (z > a.z_mm && z < b.z_mm) bounds_.push_back({z, a.u_mm + a.slope * (z - a.z_mm)});
+    }
   }
 
   ProfileFit run() {
@@ -133,7 +146,7 @@ class Fitter {
   // The line of slope m through the outermost (outside) / innermost (inside) sample.
   Line support_above(double m) const {
     double c = -std::numeric_limits<double>::infinity();
-    for (const Point& p : present_) c = std::max(c, p.u - m * (p.z - zb_));
+    for (const Point& p : bounds_) c = std::max(c, p.u - m * (p.z - zb_));
     return {c, m};
   }
   Line support_below(double m) const {
@@ -329,6 +342,17 @@ class Fitter {
       }
       if (present_.size() == 1) surface.push_back({p, p});
     }
+    // Sub-slices are read just inside the layer's faces: the surface continues to the face
+    // along its tangent.
+    auto extend = [&](const ProfileSample& s, double z_face) {
+      if (!s.present || std::abs(z_face - s.z_mm) > 0.05 * (zt_ - zb_)) return;
+      const double m = std::isfinite(s.slope) ? std::clamp(s.slope, -1e3, 1e3) : 0.0;
+      surface.push_back({{s.z_mm, s.u_mm}, {z_face, s.u_mm + m * (z_face - s.z_mm)}});
+    };
+    if (!all_.empty()) {
+      extend(all_.front(), zb_);
+      extend(all_.back(), zt_);
+    }
     auto dist_to_seg = [](const Point& p, const Point& a, const Point& b) {
       const double dz = b.z - a.z, du = b.u - a.u;
       const double len2 = dz * dz + du * du;
@@ -357,6 +381,7 @@ class Fitter {
   ProfileFitParams params_;
   double tan_max_ = 0.0;
   std::vector<Point> present_;
+  std::vector<Point> bounds_;  // present_ plus the tangent corners between them
   double chord_slope_ = 0.0;
   ProfileShape shape_ = ProfileShape::empty;
   bool limited_ = false;
