@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace lamina {
 
@@ -39,10 +40,184 @@ struct OutlineRing {
   int parent = -1;
 };
 
-// The union of every sub-slice's material: what a vertical outside cut would keep. Outer rings
-// CCW, holes CW, holes linked to their outer ring.
-std::vector<OutlineRing> layer_outline_rings(const std::vector<const Slice*>& sub_slices) {
-  ClipperLib::Paths all;
+// Material that lies between two sub-slices and outside both: a bore's underside, the top of a
+// dome, a step — where the surface turns (nearly) horizontal between two thin slices. Such a
+// facet's part inside the layer is projected onto the layer's outline; facets whose clipped
+// corners all sit inside a neighbouring sub-slice add nothing and are skipped (the common case
+// on smooth surfaces, and what keeps this cheap).
+ClipperLib::Paths facet_shadows(const Mesh& mesh, const std::vector<double>& zs, const std::vector<SectionLines>& sections) {
+  ClipperLib::Paths shadows;
+  // Between the outer sub-slices, which are read just inside the faces: a flat face of the
+  // model lying on a layer face belongs to the neighbouring layer.
+  const double zb = zs.front(), zt = zs.back();
+  std::vector<Eigen::Vector3d> poly, next;
+  auto inside_neighbour = [&](const Eigen::Vector3d& v) {
+    const auto it = std::upper_bound(zs.begin(), zs.end(), v.z());
+    const std::size_t hi = std::min<std::size_t>(static_cast<std::size_t>(it - zs.begin()), zs.size() - 1);
+    const std::size_t lo = hi > 0 ? hi - 1 : 0;
+    const Eigen::Vector2d p = v.head<2>();
+    return sections[lo].contains(p) || sections[hi].contains(p);
+  };
+  for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
+    if (std::abs(mesh.normals[f].z()) < 0.02) continue;  // a wall: its shadow is a line
+    const auto& tri = mesh.faces[f];
+    const Eigen::Vector3d& a = mesh.vertices[static_cast<std::size_t>(tri[0])];
+    const Eigen::Vector3d& b = mesh.vertices[static_cast<std::size_t>(tri[1])];
+    const Eigen::Vector3d& c = mesh.vertices[static_cast<std::size_t>(tri[2])];
+    const double lo = std::min({a.z(), b.z(), c.z()}), hi = std::max({a.z(), b.z(), c.z()});
+    if (hi < zb || lo > zt) continue;
+    // Clip to zb ≤ z ≤ zt (Sutherland–Hodgman on the two planes).
+    poly.assign({a, b, c});
+    for (int side = 0; side < 2 && !poly.empty(); ++side) {
+      next.clear();
+      auto keep = [&](const Eigen::Vector3d& v) { return side == 0 ? v.z() >= zb : v.z() <= zt; };
+      const double plane = side == 0 ? zb : zt;
+      for (std::size_t i = 0; i < poly.size(); ++i) {
+        const Eigen::Vector3d& p = poly[i];
+        const Eigen::Vector3d& q = poly[(i + 1) % poly.size()];
+        if (keep(p)) next.push_back(p);
+        if (keep(p) != keep(q)) next.push_back(p + (q - p) * ((plane - p.z()) / (q.z() - p.z())));
+      }
+      poly.swap(next);
+    }
+    if (poly.size() < 3) continue;
+    // Corners, edge midpoints and the centre: a facet bridging a hole of its neighbours (a
+    // tunnel's roof) has its corners inside but not its middle.
+    bool all_inside = true;
+    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+    for (std::size_t i = 0; i < poly.size() && all_inside; ++i) {
+      centre += poly[i];
+      all_inside = inside_neighbour(poly[i]) && inside_neighbour(0.5 * (poly[i] + poly[(i + 1) % poly.size()]));
+    }
+    all_inside = all_inside && inside_neighbour(centre / static_cast<double>(poly.size()));
+    if (all_inside) continue;
+    Polygon2 ring;
+    for (const auto& v : poly) ring.emplace_back(v.x(), v.y());
+    if (signed_area_mm2(ring) < 0) std::reverse(ring.begin(), ring.end());
+    shadows.push_back(detail::to_clipper(ring));
+  }
+  return shadows;
+}
+
+// The facets inside a layer, bucketed by their footprint, so that a station can read the exact
+// trace of the surface in its profile plane (every facet the plane cuts), not only the points
+// on the sub-slices.
+class SlabFacets {
+ public:
+  SlabFacets(const Mesh& mesh, double zb, double zt, double cell_mm) : mesh_(mesh), zb_(zb), zt_(zt) {
+    Eigen::Vector2d lo(std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()), hi = -lo;
+    for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
+      const auto [a, b, c] = corners(f);
+      const double zl = std::min({a.z(), b.z(), c.z()}), zh = std::max({a.z(), b.z(), c.z()});
+      if (zh < zb || zl > zt) continue;
+      facets_.push_back(static_cast<std::uint32_t>(f));
+      lo = lo.cwiseMin(a.head<2>()).cwiseMin(b.head<2>()).cwiseMin(c.head<2>());
+      hi = hi.cwiseMax(a.head<2>()).cwiseMax(b.head<2>()).cwiseMax(c.head<2>());
+    }
+    if (facets_.empty()) return;
+    origin_ = lo;
+    const Eigen::Vector2d size = (hi - lo).cwiseMax(1e-9);
+    cell_ = std::max({cell_mm, std::sqrt(size.x() * size.y() / static_cast<double>(facets_.size())), std::max(size.x(), size.y()) / 2048.0});
+    nx_ = std::max(1, static_cast<int>(std::ceil(size.x() / cell_)));
+    ny_ = std::max(1, static_cast<int>(std::ceil(size.y() / cell_)));
+    begin_.assign(static_cast<std::size_t>(nx_) * ny_ + 1, 0);
+    auto each_cell = [&](std::uint32_t f, auto&& fn) {
+      const auto [a, b, c] = corners(f);
+      const Eigen::Vector2d l = (a.head<2>().cwiseMin(b.head<2>()).cwiseMin(c.head<2>()) - origin_) / cell_;
+      const Eigen::Vector2d h = (a.head<2>().cwiseMax(b.head<2>()).cwiseMax(c.head<2>()) - origin_) / cell_;
+      for (int y = clampi(l.y(), ny_); y <= clampi(h.y(), ny_); ++y)
+        for (int x = clampi(l.x(), nx_); x <= clampi(h.x(), nx_); ++x) fn(static_cast<std::size_t>(y) * nx_ + x);
+    };
+    for (std::uint32_t f : facets_) each_cell(f, [&](std::size_t c) { ++begin_[c + 1]; });
+    for (std::size_t c = 0; c + 1 < begin_.size(); ++c) begin_[c + 1] += begin_[c];
+    items_.resize(begin_.back());
+    std::vector<std::uint32_t> fill(begin_.begin(), begin_.end() - 1);
+    for (std::uint32_t f : facets_) each_cell(f, [&](std::size_t c) { items_[fill[c]++] = f; });
+  }
+
+  // Points of the surface's trace in the vertical plane through `base` along `n`, for u in
+  // [u_min, u_max] and z in the layer: the ends of every facet's cut by the plane, clipped.
+  void trace(const Eigen::Vector2d& base, const Eigen::Vector2d& n, double u_min, double u_max,
+             std::vector<ProfileBound>& out, std::vector<std::uint32_t>& seen) const {
+    out.clear();
+    seen.clear();
+    if (facets_.empty()) return;
+    const Eigen::Vector2d t(-n.y(), n.x());
+    const double len = u_max - u_min;
+    const int steps = std::max(1, static_cast<int>(std::ceil(len / (0.5 * cell_))));
+    std::size_t last_cell = static_cast<std::size_t>(-1);
+    for (int k = 0; k <= steps; ++k) {
+      const Eigen::Vector2d p = (base + (u_min + len * k / steps) * n - origin_) / cell_;
+      const int cx = static_cast<int>(std::floor(p.x())), cy = static_cast<int>(std::floor(p.y()));
+      // The line may pass a cell's corner between two samples: look at the 3×3 block.
+      for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
+          const int x = cx + dx, y = cy + dy;
+          if (x < 0 || y < 0 || x >= nx_ || y >= ny_) continue;
+          const std::size_t c = static_cast<std::size_t>(y) * nx_ + x;
+          if (c == last_cell) continue;
+          for (std::uint32_t i = begin_[c]; i < begin_[c + 1]; ++i) seen.push_back(items_[i]);
+        }
+      }
+    }
+    std::sort(seen.begin(), seen.end());
+    seen.erase(std::unique(seen.begin(), seen.end()), seen.end());
+    for (std::uint32_t f : seen) {
+      const auto [a, b, c] = corners(f);
+      const Eigen::Vector3d v[3] = {a, b, c};
+      double d[3];
+      for (int i = 0; i < 3; ++i) d[i] = (v[i].head<2>() - base).dot(t);
+      Eigen::Vector2d ends[2];  // (u, z)
+      int found = 0;
+      for (int i = 0; i < 3 && found < 2; ++i) {
+        const int j = (i + 1) % 3;
+        if ((d[i] < 0) == (d[j] < 0)) continue;
+        const double s = d[i] / (d[i] - d[j]);
+        const Eigen::Vector3d q = v[i] + s * (v[j] - v[i]);
+        ends[found++] = Eigen::Vector2d((q.head<2>() - base).dot(n), q.z());
+      }
+      if (found < 2) continue;
+      clip_and_add(ends[0], ends[1], u_min, u_max, out);
+    }
+  }
+
+ private:
+  static int clampi(double v, int n) { return std::clamp(static_cast<int>(std::floor(v)), 0, n - 1); }
+
+  std::array<Eigen::Vector3d, 3> corners(std::size_t f) const {
+    const auto& tri = mesh_.faces[f];
+    return {mesh_.vertices[static_cast<std::size_t>(tri[0])], mesh_.vertices[static_cast<std::size_t>(tri[1])],
+            mesh_.vertices[static_cast<std::size_t>(tri[2])]};
+  }
+
+  // Clip the segment a–b (u, z) to the layer's z range and the u window; add its ends.
+  void clip_and_add(Eigen::Vector2d a, Eigen::Vector2d b, double u_min, double u_max, std::vector<ProfileBound>& out) const {
+    double t0 = 0.0, t1 = 1.0;
+    const Eigen::Vector2d d = b - a;
+    auto clip = [&](double p, double q) {  // keep where p·t ≤ q
+      if (std::abs(p) < 1e-300) return q >= 0;
+      const double r = q / p;
+      if (p < 0) t0 = std::max(t0, r); else t1 = std::min(t1, r);
+      return t0 <= t1;
+    };
+    if (!clip(-d.y(), a.y() - zb_) || !clip(d.y(), zt_ - a.y()) || !clip(-d.x(), a.x() - u_min) || !clip(d.x(), u_max - a.x())) return;
+    const Eigen::Vector2d p = a + t0 * d, q = a + t1 * d;
+    out.push_back({p.y(), p.x()});
+    out.push_back({q.y(), q.x()});
+  }
+
+  const Mesh& mesh_;
+  double zb_, zt_;
+  std::vector<std::uint32_t> facets_;
+  Eigen::Vector2d origin_{0, 0};
+  double cell_ = 1.0;
+  int nx_ = 0, ny_ = 0;
+  std::vector<std::uint32_t> begin_, items_;
+};
+
+// The union of every sub-slice's material and the shadows between them: what a vertical
+// outside cut keeps. Outer rings CCW, holes CW, holes linked to their outer ring.
+std::vector<OutlineRing> layer_outline_rings(const std::vector<const Slice*>& sub_slices, ClipperLib::Paths all) {
   for (const Slice* s : sub_slices) {
     for (const Loop& l : s->loops) all.push_back(detail::to_clipper(l.points));
   }
@@ -175,7 +350,22 @@ LayerPlan plan_layer(const Mesh& mesh, const LayerSpan& span, int index, const s
   constexpr double kOnOutline = 1e-3;
 
   std::vector<ProfileSample> samples(zs.size());
-  for (const OutlineRing& ring : layer_outline_rings(sub_slices)) {
+  const SlabFacets slab(mesh, zs.front(), zs.back(), params.station_spacing_mm);
+  std::vector<ProfileBound> trace;
+  std::vector<std::uint32_t> scratch;
+  const auto rings = layer_outline_rings(sub_slices, facet_shadows(mesh, zs, lines));
+  // The outline as a section, to find how far out a line may go before it meets other material
+  // of the same layer.
+  Slice outline_slice;
+  for (const OutlineRing& ring : rings) {
+    Loop loop;
+    loop.points = ring.points;
+    loop.facets.assign(ring.points.size(), -1);
+    loop.area_mm2 = signed_area_mm2(ring.points);
+    outline_slice.loops.push_back(std::move(loop));
+  }
+  const SectionLines outline_lines(mesh, outline_slice);
+  for (const OutlineRing& ring : rings) {
     LayerOutline outline;
     outline.is_hole = ring.is_hole;
     outline.parent = ring.parent;
@@ -200,8 +390,24 @@ LayerPlan plan_layer(const Mesh& mesh, const LayerSpan& span, int index, const s
           top_normal = hit->normal;
         }
       }
-      ProfileFit fit = fit_profile(samples, zb, zt, params.fit);
-      if (fit.cuts.empty()) fit.cuts.push_back({0.0, 0.0});  // nothing found: the outline itself
+      slab.trace(seed.point, seed.normal, -reach, kOnOutline, trace, scratch);
+      // Walking out along the normal, the next material of the layer (leaving it along −n).
+      double ceiling = std::numeric_limits<double>::infinity();
+      if (const auto next = outline_lines.exit_crossing(seed.point, -seed.normal, -reach, -2 * kOnOutline, CrossingPick::largest)) {
+        ceiling = -next->u_mm - kOnOutline;
+      }
+      ProfileFit fit = fit_profile(samples, zb, zt, params.fit, trace, ceiling);
+      double outermost = -std::numeric_limits<double>::infinity();
+      for (const auto& smp : samples) {
+        if (smp.present) outermost = std::max(outermost, smp.u_mm);
+      }
+      if (fit.cuts.empty() || outermost < -kOnOutline) {
+        // The outline here comes from material between sub-slices (a shadow), which the
+        // profile cannot see: only the vertical cut on the outline is sure to stay outside.
+        const double gap = std::isfinite(outermost) ? -outermost : 0.0;
+        fit.cuts.assign(1, CutLine1D{0.0, 0.0});
+        fit.max_deviation_mm = std::max(fit.max_deviation_mm, gap);
+      }
       st.shape = fit.shape;
       st.slope_rule_agrees = fit.slope_rule_agrees;
       st.tilt_limited = fit.tilt_limited;

@@ -52,8 +52,9 @@ struct Line {
 
 class Fitter {
  public:
-  Fitter(std::span<const ProfileSample> samples, double z_bottom, double z_top, const ProfileFitParams& params)
-      : all_(samples), zb_(z_bottom), zt_(z_top), params_(params) {
+  Fitter(std::span<const ProfileSample> samples, double z_bottom, double z_top, const ProfileFitParams& params,
+         std::span<const ProfileBound> surface, double ceiling)
+      : all_(samples), zb_(z_bottom), zt_(z_top), params_(params), ceiling_(ceiling) {
     tan_max_ = params.tilt_max_rad >= 0.5 * M_PI - 1e-9 ? 1e12 : std::tan(params.tilt_max_rad);
     for (const auto& s : samples) {
       if (s.present && std::isfinite(s.u_mm)) present_.push_back({s.z_mm, s.u_mm});
@@ -62,7 +63,8 @@ class Fitter {
     // samples. Where the tangents are known, the point where neighbouring tangents meet bounds
     // the bulge; outside lines clear those corners too.
     bounds_ = present_;
-    for (std::size_t i = 0; i + 1 < samples.size(); ++i) {
+    for (const auto& b : surface) bounds_.push_back({b.z_mm, b.u_mm});
+    for (std::size_t i = 0; surface.empty() && i + 1 < samples.size(); ++i) {
       const auto& a = samples[i];
       const auto& b = samples[i + 1];
       if (!a.present || !b.present || !std::isfinite(a.slope) || !std::isfinite(b.slope)) continue;
@@ -78,6 +80,9 @@ class Fitter {
     if (present_.empty()) return fit;  // shape empty, no cut: nothing of the part on this line
     classify(fit);
     std::vector<Line> lines = choose_lines(fit);
+    for (Line& l : lines) {
+      if (std::max(l.at(zb_, zb_), l.at(zt_, zb_)) > ceiling_) l = support_above(0.0);
+    }
     fit.cuts.reserve(lines.size());
     for (const Line& l : lines) fit.cuts.push_back({l.at(zb_, zb_), l.at(zt_, zb_)});
     fit.max_deviation_mm = deviation(lines);
@@ -379,6 +384,7 @@ class Fitter {
   std::span<const ProfileSample> all_;
   double zb_, zt_;
   ProfileFitParams params_;
+  double ceiling_;
   double tan_max_ = 0.0;
   std::vector<Point> present_;
   std::vector<Point> bounds_;  // present_ plus the tangent corners between them
@@ -390,8 +396,8 @@ class Fitter {
 }  // namespace
 
 ProfileFit fit_profile(std::span<const ProfileSample> samples, double z_bottom_mm, double z_top_mm,
-                       const ProfileFitParams& params) {
-  return Fitter(samples, z_bottom_mm, z_top_mm, params).run();
+                       const ProfileFitParams& params, std::span<const ProfileBound> bounds, double u_ceiling_mm) {
+  return Fitter(samples, z_bottom_mm, z_top_mm, params, bounds, u_ceiling_mm).run();
 }
 
 double cut_edge_at(const ProfileFit& fit, double z_mm, double z_bottom_mm, double z_top_mm) {

@@ -126,7 +126,9 @@ TEST(BevelShapes, SphereGetsTangentCutsWithinTheTiltLimitAndContinuousC) {
           ASSERT_LE(l.tilt_rad, limit + 1e-9);
           EXPECT_NEAR(l.tool_axis.norm(), 1.0, 1e-12);
           const auto& prev = pass.lines[(i + pass.lines.size() - 1) % pass.lines.size()];
-          if (i > 0) EXPECT_LT(std::abs(l.c_rad - prev.c_rad), 0.5) << "C jumps at layer " << layer.index << " station " << i;
+          if (i > 0) {
+            EXPECT_LT(std::abs(l.c_rad - prev.c_rad), 0.5) << "C jumps at layer " << layer.index << " station " << i;
+          }
         }
       }
     }

@@ -10,6 +10,7 @@
 //
 // Pure 1-D geometry: everything that needs the mesh (finding the samples) lives in bevel.cpp.
 #include <cstdint>
+#include <limits>
 #include <span>
 #include <vector>
 
@@ -67,10 +68,21 @@ struct ProfileFit {
   double max_deviation_mm = 0.0;
 };
 
+// A point of the model's surface in the profile plane (the trace of a facet): outside cuts must
+// pass at or beyond every such point, so they clear the surface between sub-slices too.
+struct ProfileBound {
+  double z_mm = 0.0;
+  double u_mm = 0.0;
+};
+
 // Classify the profile and choose its cut lines for the given side, strategy and tilt limit.
-// samples are in increasing z between z_bottom_mm and z_top_mm (inclusive).
+// samples are in increasing z between z_bottom_mm and z_top_mm (inclusive). Without bounds, the
+// corners of neighbouring tangents stand in for the surface between samples. No line may go
+// beyond u_ceiling_mm (the next material of the layer out along the station's normal: another
+// island, the far side of a slot); such a line is replaced by the vertical supporting one.
 ProfileFit fit_profile(std::span<const ProfileSample> samples, double z_bottom_mm, double z_top_mm,
-                       const ProfileFitParams& params);
+                       const ProfileFitParams& params, std::span<const ProfileBound> bounds = {},
+                       double u_ceiling_mm = std::numeric_limits<double>::infinity());
 
 // The edge the cuts leave at height z: min over the lines (the intersection of their sides).
 double cut_edge_at(const ProfileFit& fit, double z_mm, double z_bottom_mm, double z_top_mm);
