@@ -217,7 +217,8 @@ class SlabFacets {
 
 // The union of every sub-slice's material and the shadows between them: what a vertical
 // outside cut keeps. Outer rings CCW, holes CW, holes linked to their outer ring.
-std::vector<OutlineRing> layer_outline_rings(const std::vector<const Slice*>& sub_slices, ClipperLib::Paths all) {
+std::vector<OutlineRing> layer_outline_rings(const std::vector<const Slice*>& sub_slices, ClipperLib::Paths all,
+                                             double min_hole_width_mm) {
   for (const Slice* s : sub_slices) {
     for (const Loop& l : s->loops) all.push_back(detail::to_clipper(l.points));
   }
@@ -236,7 +237,15 @@ std::vector<OutlineRing> layer_outline_rings(const std::vector<const Slice*>& su
     r.points = detail::from_clipper(path);
     r.is_hole = node.IsHole();
     r.parent = parent;
-    if (std::abs(signed_area_mm2(r.points)) < 1e-8) return -1;
+    const double area = std::abs(signed_area_mm2(r.points));
+    if (area < 1e-8) return -1;
+    if (r.is_hole) {
+      // Mean width of the hole (2·area / perimeter): slivers between sub-slices that no jet can
+      // cut are left closed — keeping material there is on the safe side of "outside".
+      double perimeter = 0.0;
+      for (std::size_t i = 0; i < r.points.size(); ++i) perimeter += (r.points[(i + 1) % r.points.size()] - r.points[i]).norm();
+      if (2.0 * area / perimeter < min_hole_width_mm) return -2;
+    }
     rings.push_back(std::move(r));
     return static_cast<int>(rings.size()) - 1;
   };
@@ -246,6 +255,7 @@ std::vector<OutlineRing> layer_outline_rings(const std::vector<const Slice*>& su
     auto [node, parent] = stack.back();
     stack.pop_back();
     const int self = add(*node, node->IsHole() ? parent : -1);
+    if (self == -2) continue;  // a closed sliver: what lies inside it is inside the material
     // Holes belong to the outer above them; islands inside a hole are new outers.
     for (const ClipperLib::PolyNode* child : node->Childs) stack.emplace_back(child, node->IsHole() ? -1 : self);
   }
@@ -353,7 +363,7 @@ LayerPlan plan_layer(const Mesh& mesh, const LayerSpan& span, int index, const s
   const SlabFacets slab(mesh, zs.front(), zs.back(), params.station_spacing_mm);
   std::vector<ProfileBound> trace;
   std::vector<std::uint32_t> scratch;
-  const auto rings = layer_outline_rings(sub_slices, facet_shadows(mesh, zs, lines));
+  const auto rings = layer_outline_rings(sub_slices, facet_shadows(mesh, zs, lines), params.min_hole_width_mm);
   // The outline as a section, to find how far out a line may go before it meets other material
   // of the same layer.
   Slice outline_slice;

@@ -78,6 +78,9 @@ struct BevelParams {
   double sub_slice_mm = 0.5;        // spacing of the thin slices inside a layer (paper's thin layers)
   double station_spacing_mm = 1.0;  // outline edges longer than this get extra stations
   double tolerance_mm = 0.1;        // within_tolerance threshold for max_deviation_mm
+  // Holes of a layer outline narrower than this (mean width 2·area/perimeter) stay closed: a
+  // jet cannot cut them, and they are mostly slivers where sub-slices nearly coincide.
+  double min_hole_width_mm = 0.1;
   bool parallel = true;             // layers on several threads (TBB); results do not depend on it
 };
 
