@@ -132,7 +132,8 @@ class SlabFacets {
     for (std::size_t c = 0; c + 1 < begin_.size(); ++c) begin_[c + 1] += begin_[c];
     items_.resize(begin_.back());
     std::vector<std::uint32_t> fill(begin_.begin(), begin_.end() - 1);
-    for (std::uint32_t f : facets_) each_cell(f, [&](std::size_t c) { items_[fill[c]++] = f; });
+    for (std::uint32_t i = 0; i < facets_.size(); ++i) each_cell(facets_[i], [&](std::size_t c) { items_[fill[c]++] = i; });
+    stamp_.assign(facets_.size(), 0u);
   }
 
   // Points of the surface's trace in the vertical plane through `base` along `n`, for u in
@@ -145,23 +146,34 @@ class SlabFacets {
     const Eigen::Vector2d t(-n.y(), n.x());
     const double len = u_max - u_min;
     const int steps = std::max(1, static_cast<int>(std::ceil(len / (0.5 * cell_))));
-    std::size_t last_cell = static_cast<std::size_t>(-1);
+    // The cells the line passes (and their neighbours: it may cut a corner between two
+    // samples), each once; then their facets, each once (stamped).
+    cells_.clear();
     for (int k = 0; k <= steps; ++k) {
       const Eigen::Vector2d p = (base + (u_min + len * k / steps) * n - origin_) / cell_;
       const int cx = static_cast<int>(std::floor(p.x())), cy = static_cast<int>(std::floor(p.y()));
-      // The line may pass a cell's corner between two samples: look at the 3×3 block.
       for (int dy = -1; dy <= 1; ++dy) {
         for (int dx = -1; dx <= 1; ++dx) {
           const int x = cx + dx, y = cy + dy;
           if (x < 0 || y < 0 || x >= nx_ || y >= ny_) continue;
-          const std::size_t c = static_cast<std::size_t>(y) * nx_ + x;
-          if (c == last_cell) continue;
-          for (std::uint32_t i = begin_[c]; i < begin_[c + 1]; ++i) seen.push_back(items_[i]);
+          cells_.push_back(static_cast<std::uint32_t>(y * nx_ + x));
         }
       }
     }
-    std::sort(seen.begin(), seen.end());
-    seen.erase(std::unique(seen.begin(), seen.end()), seen.end());
+    std::sort(cells_.begin(), cells_.end());
+    cells_.erase(std::unique(cells_.begin(), cells_.end()), cells_.end());
+    if (++generation_ == 0) {
+      std::fill(stamp_.begin(), stamp_.end(), 0u);
+      generation_ = 1;
+    }
+    for (std::uint32_t c : cells_) {
+      for (std::uint32_t i = begin_[c]; i < begin_[c + 1]; ++i) {
+        const std::uint32_t local = items_[i];
+        if (stamp_[local] == generation_) continue;
+        stamp_[local] = generation_;
+        seen.push_back(facets_[local]);
+      }
+    }
     for (std::uint32_t f : seen) {
       const auto [a, b, c] = corners(f);
       const Eigen::Vector3d v[3] = {a, b, c};
@@ -212,7 +224,10 @@ class SlabFacets {
   Eigen::Vector2d origin_{0, 0};
   double cell_ = 1.0;
   int nx_ = 0, ny_ = 0;
-  std::vector<std::uint32_t> begin_, items_;
+  std::vector<std::uint32_t> begin_, items_;  // CSR: cell → index into facets_
+  // Per-query scratch: one SlabFacets serves one layer on one thread.
+  mutable std::vector<std::uint32_t> stamp_, cells_;
+  mutable std::uint32_t generation_ = 0;
 };
 
 // The union of every sub-slice's material and the shadows between them: what a vertical

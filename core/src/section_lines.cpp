@@ -171,22 +171,32 @@ bool SectionLines::contains(const Eigen::Vector2d& p) const {
   if (segments_.empty()) return false;
   const Eigen::Vector2d g = (p - origin_) / cell_mm_;
   const int cy = static_cast<int>(std::floor(g.y()));
-  if (cy < 0 || cy >= ny_ || g.x() >= nx_) return false;
-  const int cx0 = std::max(0, static_cast<int>(std::floor(g.x())));
-  // Count crossings of the ray +x from p, each segment once (it may sit in several cells).
-  std::vector<std::uint32_t> hits;
-  for (int cx = cx0; cx < nx_; ++cx) {
+  if (cy < 0 || cy >= ny_ || g.x() >= nx_ || g.x() < 0) return false;
+  const int cx0 = static_cast<int>(std::floor(g.x()));
+  // Count crossings of a horizontal ray from p towards the nearer side of the grid, each
+  // segment once (it may sit in several cells of the row).
+  const bool right = cx0 >= nx_ / 2;
+  std::uint32_t hits[128];
+  int count = 0;
+  std::vector<std::uint32_t> overflow;
+  const int from = right ? cx0 : 0, to = right ? nx_ : cx0 + 1;
+  for (int cx = from; cx < to; ++cx) {
     const std::size_t c = static_cast<std::size_t>(cy) * nx_ + cx;
     for (std::uint32_t k = cell_begin_[c]; k < cell_begin_[c + 1]; ++k) {
-      const Segment& s = segments_[cell_items_[k]];
+      const std::uint32_t idx = cell_items_[k];
+      const Segment& s = segments_[idx];
       if ((s.a.y() > p.y()) == (s.b.y() > p.y())) continue;
       const double x = s.a.x() + (p.y() - s.a.y()) * (s.b.x() - s.a.x()) / (s.b.y() - s.a.y());
-      if (x > p.x()) hits.push_back(cell_items_[k]);
+      if ((x > p.x()) != right) continue;
+      bool seen = false;
+      for (int i = 0; i < count && !seen; ++i) seen = hits[i] == idx;
+      if (seen) continue;
+      if (count < 128) hits[count++] = idx; else overflow.push_back(idx);
     }
   }
-  std::sort(hits.begin(), hits.end());
-  const auto count = std::unique(hits.begin(), hits.end()) - hits.begin();
-  return (count % 2) == 1;
+  std::sort(overflow.begin(), overflow.end());
+  const auto extra = std::unique(overflow.begin(), overflow.end()) - overflow.begin();
+  return ((count + extra) % 2) == 1;
 }
 
 }  // namespace lamina
