@@ -1,0 +1,131 @@
+// choose_layers: validate, build the grid estimator, run the chosen method, report.
+#include "lamina/core/layering.hpp"
+
+#include "layering_internal.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace lamina {
+
+const char* layering_method_name(LayeringMethod method) {
+  switch (method) {
+    case LayeringMethod::optimal: return "optimal";
+    case LayeringMethod::greedy: return "greedy";
+  }
+  return "?";
+}
+
+namespace {
+
+std::unexpected<Error> invalid(std::string message) {
+  return std::unexpected(Error{ErrorCode::invalid_argument, "layering: " + std::move(message)});
+}
+
+std::expected<std::vector<double>, Error> validate(const LayeringParams& p) {
+  if (p.thicknesses_mm.empty()) return invalid("no stock thickness given (thicknesses_mm is empty)");
+  for (std::size_t i = 0; i < p.thicknesses_mm.size(); ++i) {
+    const double t = p.thicknesses_mm[i];
+    if (!std::isfinite(t) || t <= 0.0)
+      return invalid(fmt::format("stock thickness #{} is {} mm; thicknesses must be finite and > 0", i + 1, t));
+    if (t < layering_detail::kPositionQuantum)
+      return invalid(fmt::format("stock thickness #{} is {} mm, below 1 µm", i + 1, t));
+  }
+  if (!std::isfinite(p.sub_slice_mm) || p.sub_slice_mm <= 0.0)
+    return invalid(fmt::format("sub_slice_mm is {}; it must be finite and > 0", p.sub_slice_mm));
+  if (!std::isfinite(p.bond_mm) || p.bond_mm < 0.0)
+    return invalid(fmt::format("bond_mm is {}; it must be finite and >= 0", p.bond_mm));
+  if (!std::isfinite(p.tolerance_mm) || p.tolerance_mm <= 0.0)
+    return invalid(fmt::format("tolerance_mm is {}; it must be finite and > 0", p.tolerance_mm));
+  if (!std::isfinite(p.greedy_area_deviation) || p.greedy_area_deviation < 0.0)
+    return invalid(fmt::format("greedy_area_deviation is {}; it must be finite and >= 0", p.greedy_area_deviation));
+  if (!std::isfinite(p.greedy_triangle_area_mm2) || p.greedy_triangle_area_mm2 < 0.0)
+    return invalid(fmt::format("greedy_triangle_area_mm2 is {}; it must be finite and >= 0", p.greedy_triangle_area_mm2));
+  if (!std::isfinite(p.fit.tilt_max_rad) || p.fit.tilt_max_rad < 0.0 || p.fit.tilt_max_rad > 1.5707963267948966)
+    return invalid(fmt::format("fit.tilt_max_rad is {}; it must be in [0, pi/2]", p.fit.tilt_max_rad));
+  if (p.method != LayeringMethod::optimal && p.method != LayeringMethod::greedy)
+    return invalid("unknown layering method");
+  std::vector<double> t = p.thicknesses_mm;
+  std::sort(t.begin(), t.end());
+  t.erase(std::unique(t.begin(), t.end(), [](double a, double b) { return b - a <= 1e-9; }), t.end());
+  return t;
+}
+
+}  // namespace
+
+std::expected<Layering, Error> choose_layers(const Mesh& mesh, const LayeringParams& params) {
+  auto thicknesses = validate(params);
+  if (!thicknesses) return std::unexpected(thicknesses.error());
+  auto created = layering_detail::Estimator::create(mesh, params, *thicknesses);
+  if (!created) return std::unexpected(created.error());
+  layering_detail::Estimator& est = **created;
+  const std::vector<double>& t = est.thicknesses();
+
+  const auto chosen = params.method == LayeringMethod::greedy ? layering_detail::layer_greedy(est, params)
+                                                               : layering_detail::layer_optimal(est, params);
+  Layering out;
+  out.model_height_mm = est.height();
+  for (const auto& c : chosen) {
+    LayerSpan l;
+    l.z_bottom_mm = est.z_base() + c.z_rel;
+    l.thickness_mm = t[static_cast<std::size_t>(c.thickness_index)];
+    l.estimated_deviation_mm = c.estimate;
+    l.within_tolerance = c.within;
+    out.layers.push_back(l);
+  }
+  out.stack_height_mm = out.layers.empty() ? 0.0 : out.layers.back().z_top_mm() - est.z_base();
+
+  // Shortfalls: runs of layers where no sheet met the tolerance (the thinnest was used).
+  for (std::size_t i = 0; i < out.layers.size(); ++i) {
+    const LayerSpan& l = out.layers[i];
+    if (l.within_tolerance) continue;
+    if (i > 0 && !out.layers[i - 1].within_tolerance) {
+      Shortfall& s = out.shortfalls.back();
+      s.z_to_mm = l.z_top_mm();
+      s.deviation_mm = std::max(s.deviation_mm, l.estimated_deviation_mm);
+    } else {
+      out.shortfalls.push_back(Shortfall{l.z_bottom_mm, l.z_top_mm(), l.estimated_deviation_mm});
+    }
+  }
+
+  auto& w = out.warnings;
+  if (!mesh.usable()) w.push_back("the mesh has defects that make it unusable as a solid; the layering is approximate");
+  for (const auto& s : est.warnings()) w.push_back(s);
+  for (double th : t) {
+    const double r = th / params.sub_slice_mm;
+    if (std::abs(r - std::round(r)) > 1e-6)
+      w.push_back(fmt::format("stock thickness {} mm is not a multiple of the sub-slice spacing {} mm: its layers "
+                              "are estimated on the nearest grid lines",
+                              th, params.sub_slice_mm));
+  }
+  if (params.bond_mm > 0.0) {
+    const double r = params.bond_mm / params.sub_slice_mm;
+    if (std::abs(r - std::round(r)) > 1e-6)
+      w.push_back(fmt::format("the bond gap ({} mm) puts layers off the {} mm grid: their estimates use the "
+                              "nearest grid lines",
+                              params.bond_mm, params.sub_slice_mm));
+  }
+  const double over = out.stack_height_mm - out.model_height_mm;
+  if (over > 1e-6 && !out.layers.empty()) {
+    const LayerSpan& top = out.layers.back();
+    w.push_back(fmt::format("the stack is {:.3f} mm taller than the model ({:.3f} mm vs {:.3f} mm): the top "
+                            "{} mm sheet covers the last {:.3f} mm of the model",
+                            over, out.stack_height_mm, out.model_height_mm, top.thickness_mm,
+                            est.z_base() + out.model_height_mm - top.z_bottom_mm));
+  }
+  for (const Shortfall& s : out.shortfalls) {
+    if (params.method == LayeringMethod::greedy)
+      w.push_back(fmt::format("between z {:.3f} and {:.3f} mm no sheet meets the area/triangle criteria: the "
+                              "thinnest ({} mm) was used (estimated deviation {:.3f} mm)",
+                              s.z_from_mm, s.z_to_mm, t.front(), s.deviation_mm));
+    else
+      w.push_back(fmt::format("between z {:.3f} and {:.3f} mm no sheet meets the tolerance of {} mm: the thinnest "
+                              "({} mm) was used (estimated deviation {:.3f} mm)",
+                              s.z_from_mm, s.z_to_mm, params.tolerance_mm, t.front(), s.deviation_mm));
+  }
+  return out;
+}
+
+}  // namespace lamina
