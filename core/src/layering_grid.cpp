@@ -10,15 +10,15 @@
 #include <atomic>
 #include <cmath>
 #include <limits>
-#include <numeric>
 
 namespace lamina::layering_detail {
 
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-// More grid lines than this is a mistake in the parameters (0.001 mm steps over a metre).
-constexpr int kMaxGridLines = 1'000'000;
+// More grid lines than this is a mistake in the parameters (0.01 mm steps over a metre): every
+// sub-slice is kept in memory with its line index.
+constexpr int kMaxGridLines = 100'000;
 // A surface flatter than this (|du/dz|, i.e. within ~6° of horizontal) between two slices, or a
 // change of loop count, makes the section change "abruptly": stations are read there too.
 constexpr double kAbruptSlope = 10.0;
@@ -45,7 +45,6 @@ double loop_perimeter(const Loop& l) {
 std::expected<std::unique_ptr<Estimator>, Error> Estimator::create(const Mesh& mesh, const LayeringParams& params,
                                                                    std::vector<double> thicknesses) {
   std::unique_ptr<Estimator> e(new Estimator());
-  e->mesh_ = &mesh;
   e->params_ = params;
   e->thicknesses_ = std::move(thicknesses);
   if (mesh.faces.empty()) return std::unexpected(Error{ErrorCode::empty_mesh, "layering: the mesh has no facets"});
@@ -270,8 +269,9 @@ double Estimator::station_deviation(GridSpan span, int thickness_index, int slic
   // Around an interior grid line the two slices are 2δ apart: keep both only where they differ
   // (a flat face on the line), otherwise the profile would carry every point twice.
   const double same_u = 2 * kAbruptSlope * delta_ + 1e-9;
-  std::vector<ProfileSample> samples;
-  samples.reserve(static_cast<std::size_t>(jt - jb + 1));
+  thread_local std::vector<ProfileSample> samples;
+  samples.clear();
+  bool vertical = true;  // every sample present at the same u on a vertical facet
   for (int j = jb; j <= jt; ++j) {
     ProfileSample p = read(j);
     if (j % 2 == 1 && j > jb && j < jt) {
@@ -279,7 +279,9 @@ double Estimator::station_deviation(GridSpan span, int thickness_index, int slic
       if (p.present == q.present && (!p.present || std::abs(p.u_mm - q.u_mm) <= same_u)) continue;
     }
     samples.push_back(p);
+    vertical = vertical && p.present && p.slope == 0.0 && std::abs(p.u_mm - samples.front().u_mm) <= 1e-9;
   }
+  if (vertical) return 0.0;  // a vertical wall: one vertical cut is exact
   const ProfileFit fit = fit_profile(samples, z_base_ + z_line(span.ka), z_base_ + z_line(span.kb), params_.fit);
   return fit.max_deviation_mm;
 }

@@ -118,7 +118,6 @@ class Estimator {
   void compute_stations();
   void compute_novelty();
 
-  const Mesh* mesh_ = nullptr;
   LayeringParams params_;
   std::vector<double> thicknesses_;
   double z_base_ = 0.0, height_ = 0.0, step_ = 0.0, delta_ = 0.0;
