@@ -16,6 +16,11 @@ namespace lamina {
 
 // The material a layer keeps at height z (z inside the layer): every outline's ring at that
 // height, cleaned (self-overlaps and collapsed parts removed). Outer rings CCW, holes CW.
+// A station's edge point is base + u·normal with u the lowest of its pass lines at z; the rings
+// are united with positive winding (outer +1, hole −1), so a part of a ring the cuts turned
+// backwards (a swallowtail at an inward corner, sides that crossed) keeps no material. A ring
+// more than half of whose length runs against its outline (cut past its own axis, where it can
+// come out wound the right way again) keeps nothing: an outer no material, a hole no hole.
 std::vector<Polygon2> layer_section(const LayerPlan& layer, double z_mm);
 
 struct DeviationParams {
@@ -30,8 +35,23 @@ struct Deviation {
   double volume_mm3 = 0.0;   // symmetric difference
   double volume_pct = 0.0;   // of the model's volume
   double max_mm = 0.0;       // largest distance between stack and model surfaces (both ways)
+  // Where it was found: the surface sample (on the stack or on the model) farthest from the other
+  // surface.
+  Eigen::Vector3d max_at_mm = Eigen::Vector3d::Zero();
 };
 
+// volume: sections every step_mm over the z range of both solids, each measured in the middle of
+// its step (a step that a layer face crosses is split there, so bonding gaps and faces are
+// integrated exactly); model sections from slice_mesh, stack sections from layer_section (empty
+// in a bonding gap). max_mm: a sampled two-way (Hausdorff) distance: the stack's walls (stations
+// at heights distance_sample_mm apart and where the envelope of their lines kinks, and points
+// between stations) and its exposed faces (a layer's top where the next layer does not cover it,
+// its bottom where the previous one does not: faces bonded to a neighbour are inside the part)
+// against the model's triangles, and the model's vertices and facet centroids against the stack
+// shells of stack_mesh. Both are independent of `parallel`.
+// Errors: invalid_argument for a non-positive step or spacing, a layer without thickness, an
+// outline with fewer than 3 stations or a pass without one line per station, a plan without any
+// outline, or a spacing so fine it would take more than 5·10⁷ wall samples; empty_mesh.
 std::expected<Deviation, Error> measure_deviation(const Mesh& mesh, const BevelPlan& plan,
                                                   const DeviationParams& params);
 

@@ -1,0 +1,45 @@
+#pragma once
+// Private: nearest distance from points to a set of triangles, through a bounding-volume
+// hierarchy (median split on the longest axis of the centroids, 4 triangles per leaf).
+#include <Eigen/Core>
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+namespace lamina::detail {
+
+// Squared distance from p to the triangle abc (closest point by Voronoi regions, Ericson 5.1.5);
+// degenerate triangles are measured as their edges.
+double point_triangle_distance2(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                                const Eigen::Vector3d& c);
+
+// Reorders points along a Morton (Z-order) curve over their bounding box, so that consecutive
+// points are near each other (queries in that order find a near triangle at once). Ties keep
+// their order: the result does not depend on threads.
+void sort_morton(std::vector<Eigen::Vector3d>& points, bool parallel);
+
+class TriangleTree {
+ public:
+  TriangleTree(const std::vector<Eigen::Vector3d>& vertices, const std::vector<std::array<std::int32_t, 3>>& faces,
+               bool parallel);
+
+  bool empty() const { return tris_.empty(); }
+
+  // Distance from p to the nearest triangle. When a triangle within `enough` is found the search
+  // may stop there and return that triangle's distance (≤ enough): callers after a maximum of
+  // nearest distances lose nothing by it. `hint` (a triangle of an earlier, nearby query; -1 for
+  // none) is tried first and receives the nearest triangle found.
+  double distance(const Eigen::Vector3d& p, double enough, std::int32_t& hint) const;
+
+ private:
+  struct Node {
+    Eigen::Vector3d lo, hi;
+    std::int32_t first = 0;  // leaf: first triangle; inner: index of the right child (left is next)
+    std::int32_t count = 0;  // leaf: triangles (> 0); inner: 0
+  };
+  std::vector<Node> nodes_;
+  std::vector<std::array<Eigen::Vector3d, 3>> tris_;  // in leaf order
+};
+
+}  // namespace lamina::detail
