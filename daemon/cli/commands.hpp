@@ -6,5 +6,6 @@ namespace lamina::cli {
 // Each adds its subcommand; the callback stores the process exit code in `exit_code`.
 void add_check_command(CLI::App& app, int& exit_code);
 void add_slice_command(CLI::App& app, int& exit_code);
+void add_plan_command(CLI::App& app, int& exit_code);
 
 }  // namespace lamina::cli

@@ -7,6 +7,13 @@ int main(int argc, char** argv) {
   int exit_code = 0;
   lamina::cli::add_check_command(app, exit_code);
   lamina::cli::add_slice_command(app, exit_code);
-  CLI11_PARSE(app, argc, argv);
+  lamina::cli::add_plan_command(app, exit_code);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    // CLI11 prints the message (and --help); every usage error exits 2, as in most Unix tools.
+    const int code = app.exit(e);
+    return code == 0 ? 0 : 2;
+  }
   return exit_code;
 }

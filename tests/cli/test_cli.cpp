@@ -1,48 +1,17 @@
 // The `lamina` program as users run it: exit codes, one diagnosis line per defect class, and the
 // JSON report's shape and contents.
+#include "cli_runner.hpp"
+
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include <array>
 #include <cmath>
-#include <cstdio>
-#include <filesystem>
 #include <fstream>
 #include <string>
-#include <sys/wait.h>
-#include <unistd.h>
 
 namespace {
 
-namespace fs = std::filesystem;
-
-struct CliRun {
-  int exit_code = -1;
-  std::string out;  // stdout and stderr together
-};
-
-CliRun lamina(const std::string& args) {
-  const std::string cmd = std::string(LAMINA_CLI) + " " + args + " 2>&1";
-  CliRun r;
-  FILE* p = ::popen(cmd.c_str(), "r");
-  if (!p) return r;
-  std::array<char, 4096> buf{};
-  std::size_t n;
-  while ((n = std::fread(buf.data(), 1, buf.size(), p)) > 0) r.out.append(buf.data(), n);
-  const int status = ::pclose(p);
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
-
-std::string quoted(const fs::path& p) { return "'" + p.string() + "'"; }
-
-fs::path shared_model(const char* name) { return fs::path(LAMINA_SHARED_MODELS) / name; }
-
-fs::path temp_file(const std::string& name) {
-  return fs::temp_directory_path() / ("lamina-cli-test-" + std::to_string(::getpid()) + "-" + name);
-}
-
-const fs::path kKnob = fs::path(LAMINA_EXAMPLES_DIR) / "knob.stl";
+using namespace lamina_cli_test;
 
 TEST(Cli, CheckOnTheExampleIsUsableAndWatertight) {
   const CliRun r = lamina("check " + quoted(kKnob));

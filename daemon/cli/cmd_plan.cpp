@@ -1,0 +1,178 @@
+// lamina plan MODEL --out DIR: layers from the stock, the bevel cuts of each layer, the deviation
+// of the same layering cut three ways (vertical, sloped, curved), DIR/stack.stl and DIR/report.json.
+#include "commands.hpp"
+#include "plan_options.hpp"
+#include "plan_report.hpp"
+
+#include "lamina/core/stack_mesh.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <cmath>
+#include <memory>
+#include <optional>
+#include <unistd.h>
+
+namespace lamina::cli {
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+int report_error(const Error& e, int exit_code = 1) {
+  fmt::print(stderr, "error [{}]: {}\n", error_code_name(e.code), e.message);
+  return exit_code;
+}
+
+// DIR exists (created if missing) and we may write into it; checked before any planning so a
+// typo in --out does not cost a full plan.
+std::expected<fs::path, Error> prepare_out_dir(const std::string& dir) {
+  std::error_code ec;
+  if (fs::exists(dir, ec) && !fs::is_directory(dir, ec))
+    return std::unexpected(Error{ErrorCode::io_error, fmt::format("--out {}: exists and is not a folder", dir)});
+  fs::create_directories(dir, ec);
+  if (ec)
+    return std::unexpected(
+        Error{ErrorCode::io_error, fmt::format("--out {}: cannot create the folder: {}", dir, ec.message())});
+  if (::access(dir.c_str(), W_OK | X_OK) != 0)
+    return std::unexpected(Error{ErrorCode::io_error, fmt::format("--out {}: not writable: {}", dir, std::strerror(errno))});
+  return fs::path(dir);
+}
+
+// What the layering and the plan leave for a person to decide: layers over tolerance, and layers
+// that do not fit any sheet of their thickness whose size is known.
+void add_plan_warnings(const PlanSettings& settings, const BevelPlan& plan, std::vector<std::string>& warnings) {
+  int over = 0;
+  const LayerPlan* worst = nullptr;
+  for (const LayerPlan& l : plan.layers) {
+    if (l.within_tolerance) continue;
+    ++over;
+    if (!worst || l.max_deviation_mm > worst->max_deviation_mm) worst = &l;
+  }
+  if (worst)
+    warnings.push_back(fmt::format("{} layer(s) exceed the tolerance of {} mm (worst: layer {}, {:.3f} mm)", over,
+                                   settings.tolerance_mm, worst->index, worst->max_deviation_mm));
+
+  for (const LayerPlan& l : plan.layers) {
+    double x0 = 1e300, y0 = 1e300, x1 = -1e300, y1 = -1e300;
+    for (const LayerOutline& o : l.outlines)
+      for (const CutStation& s : o.stations) {
+        x0 = std::min(x0, s.base_mm.x()), x1 = std::max(x1, s.base_mm.x());
+        y0 = std::min(y0, s.base_mm.y()), y1 = std::max(y1, s.base_mm.y());
+      }
+    if (x1 < x0) continue;
+    const double a = std::max(x1 - x0, y1 - y0), b = std::min(x1 - x0, y1 - y0);
+    bool known = false, fits = false;
+    for (const SheetStock& s : settings.stock.sheets) {
+      if (std::abs(s.thickness_mm - l.thickness_mm) > 1e-9 || s.width_mm <= 0.0 || s.length_mm <= 0.0) continue;
+      known = true;
+      fits = fits || (a <= std::max(s.width_mm, s.length_mm) && b <= std::min(s.width_mm, s.length_mm));
+    }
+    if (known && !fits)
+      warnings.push_back(fmt::format("layer {} ({:.4g} x {:.4g} mm) is larger than every {} mm sheet in the stock", l.index,
+                                     x1 - x0, y1 - y0, l.thickness_mm));
+  }
+}
+
+std::string stl_header(const PlanOptions& o, const PlanResult& r) {
+  // Never "solid…": readers would take the file for ASCII STL.
+  std::string h = fmt::format("lamina stack: {} layers, {} cut, of {}", r.plan.layers.size(), o.strategy,
+                              fs::path(o.model.path).filename().string());
+  if (h.size() > 80) h.resize(80);
+  return h;
+}
+
+int run_plan(const PlanOptions& o) {
+  const auto t_start = Clock::now();
+  auto settings = resolve_plan_settings(o);
+  if (!settings) return report_error(settings.error(), settings.error().code == ErrorCode::invalid_argument ? 2 : 1);
+  auto dir = prepare_out_dir(o.out_dir);
+  if (!dir) return report_error(dir.error());
+
+  auto model = load_model(o.model);
+  if (!model) return report_error(model.error());
+  const Mesh& mesh = model->mesh;
+  PlanResult r;
+  r.warnings = settings->warnings;
+  for (const Defect& d : mesh.defects)
+    if (d.severity == Severity::error || d.severity == Severity::warning) r.warnings.push_back(d.code + ": " + d.message);
+  if (!mesh.usable())
+    return report_error({ErrorCode::invalid_argument,
+                         fmt::format("{} is not usable as a solid (see lamina check {})", o.model.path, o.model.path)});
+  r.timing.read = model->read_s;
+  r.timing.topology = model->topology_s;
+
+  auto t0 = Clock::now();
+  auto layering = choose_layers(mesh, layering_params(*settings));
+  r.timing.layering = seconds_since(t0);
+  if (!layering) return report_error(layering.error());
+  r.layering = std::move(*layering);
+  r.warnings.insert(r.warnings.end(), r.layering.warnings.begin(), r.layering.warnings.end());
+
+  t0 = Clock::now();
+  auto plan = plan_bevels(mesh, r.layering.layers, bevel_params(*settings, settings->strategy));
+  r.timing.bevel = seconds_since(t0);
+  if (!plan) return report_error(plan.error());
+  r.plan = std::move(*plan);
+  add_plan_warnings(*settings, r.plan, r.warnings);
+
+  // The same layering cut three ways; the chosen strategy's plan is reused, not recomputed.
+  t0 = Clock::now();
+  for (const BevelStrategy s : {BevelStrategy::vertical, BevelStrategy::sloped, BevelStrategy::curved}) {
+    std::optional<BevelPlan> other;
+    if (s != settings->strategy) {
+      auto p = plan_bevels(mesh, r.layering.layers, bevel_params(*settings, s));
+      if (!p) return report_error(p.error());
+      other = std::move(*p);
+    }
+    auto d = measure_deviation(mesh, other ? *other : r.plan, deviation_params(*settings));
+    if (!d) return report_error(d.error());
+    r.deviations.push_back({s, *d});
+  }
+  r.timing.deviation = seconds_since(t0);
+
+  t0 = Clock::now();
+  const std::string stl = binary_stl_bytes(stack_mesh(r.plan), stl_header(o, r));
+  // A report.json left from an earlier run must not sit next to the new stack.stl.
+  std::error_code ec;
+  fs::remove(*dir / "report.json", ec);
+  if (auto w = write_file_atomically(*dir, "stack.stl", stl); !w)
+    return report_error({ErrorCode::io_error, w.error()});
+  r.timing.write = seconds_since(t0);
+  r.timing.total = seconds_since(t_start);
+
+  const nlohmann::ordered_json report = plan_report_json(o, *settings, *model, r);
+  if (auto w = write_file_atomically(*dir, "report.json", report.dump(2) + "\n"); !w)
+    return report_error({ErrorCode::io_error, w.error()});
+
+  if (o.json) {
+    fmt::print("{}\n", report.dump(2));
+  } else {
+    print_plan_tables(stdout, report, o.all_rows);
+    fmt::print("wrote {} ({} bytes) and {}\n", (*dir / "stack.stl").string(), stl.size(),
+               (*dir / "report.json").string());
+  }
+  std::fflush(stdout);  // warnings after the tables they refer to, even when both go to one pipe
+  for (const std::string& w : r.warnings) fmt::print(stderr, "warning: {}\n", w);
+  return 0;
+}
+
+}  // namespace
+
+void add_plan_command(CLI::App& app, int& exit_code) {
+  auto o = std::make_shared<PlanOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "plan", "Choose layers from the stock, plan the bevel cuts, write DIR/stack.stl and DIR/report.json");
+  add_plan_options(*cmd, *o);
+  cmd->callback([o, &exit_code] { exit_code = run_plan(*o); });
+}
+
+}  // namespace lamina::cli

@@ -1,0 +1,181 @@
+#include "plan_options.hpp"
+
+#include "model_options.hpp"
+#include "stock_config.hpp"
+
+#include <fmt/format.h>
+
+#include <charconv>
+#include <cmath>
+#include <numbers>
+
+namespace lamina::cli {
+namespace {
+
+std::string_view trimmed(std::string_view s) {
+  while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
+  while (!s.empty() && (s.back() == ' ' || s.back() == '\t')) s.remove_suffix(1);
+  return s;
+}
+
+CutSide side_from(const std::string& s) {
+  return s == "inside" ? CutSide::inside : s == "mixed" ? CutSide::mixed : CutSide::outside;
+}
+BevelStrategy strategy_from(const std::string& s) {
+  return s == "sloped" ? BevelStrategy::sloped : s == "vertical" ? BevelStrategy::vertical : BevelStrategy::curved;
+}
+LayeringMethod layering_from(const std::string& s) {
+  return s == "greedy" ? LayeringMethod::greedy : LayeringMethod::optimal;
+}
+
+// A number in [lo, hi] (lo excluded when `open_lo`), in `unit`; CLI11's own range message prints
+// DBL_MAX in full, this one says what is wanted.
+CLI::Validator in_range(double lo, bool open_lo, double hi, std::string unit) {
+  const std::string want = hi < 1e300 ? fmt::format("{} {} … {} {}", open_lo ? "above" : "from", lo, hi, unit)
+                                      : fmt::format("{} {} {}", open_lo ? ">" : ">=", lo, unit);
+  return CLI::Validator(
+      [=](std::string& text) -> std::string {
+        const std::string_view t = trimmed(text);
+        double v = 0.0;
+        const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
+        if (t.empty() || ec != std::errc{} || end != t.data() + t.size() || !std::isfinite(v))
+          return fmt::format("'{}' is not a number", text);
+        if (v < lo || (open_lo && v == lo) || v > hi) return fmt::format("{} is out of range: must be {}", text, want);
+        return {};
+      },
+      want, "range");
+}
+
+}  // namespace
+
+std::expected<std::vector<double>, std::string> parse_thickness_list(std::string_view text) {
+  constexpr std::string_view hint = "(thicknesses in mm, separated by commas, e.g. 1,2.5,5,10)";
+  std::vector<double> out;
+  if (trimmed(text).empty()) return std::unexpected(fmt::format("empty stock list {}", hint));
+  for (std::size_t pos = 0;;) {
+    const std::size_t comma = text.find(',', pos);
+    const std::string_view item = trimmed(text.substr(pos, comma == std::string_view::npos ? comma : comma - pos));
+    if (item.empty()) return std::unexpected(fmt::format("empty item in '{}' {}", text, hint));
+    double v = 0.0;
+    const auto [end, ec] = std::from_chars(item.data(), item.data() + item.size(), v);
+    if (ec != std::errc{} || end != item.data() + item.size() || !std::isfinite(v))
+      return std::unexpected(fmt::format("'{}' is not a number {}", item, hint));
+    if (v <= 0.0) return std::unexpected(fmt::format("'{}': a sheet thickness must be > 0 mm", item));
+    out.push_back(v);
+    if (comma == std::string_view::npos) break;
+    pos = comma + 1;
+  }
+  return out;
+}
+
+void add_plan_options(CLI::App& cmd, PlanOptions& o) {
+  add_model_options(cmd, o.model);
+  cmd.add_option("--stock", o.stock_list,
+                 "Sheet thicknesses (mm), comma-separated; replaces the sheets of --stock-file")
+      ->check(CLI::Validator(
+          [](std::string& v) -> std::string {
+            auto list = parse_thickness_list(v);
+            return list ? std::string{} : list.error();
+          },
+          "MM,MM,…", "thickness list"))
+      ->each([&o](const std::string&) { o.stock_list_given = true; })
+      ->capture_default_str();
+  cmd.add_option("--stock-file", o.stock_file, "The rack as a TOML file of [[sheet]] tables (see config/stock.toml)");
+  cmd.add_option("--bond", o.bond_mm, "Bonding gap between layers (mm)")->check(in_range(0.0, false, 1e308, "mm"))->capture_default_str();
+  cmd.add_option("--sub-slice", o.sub_slice_mm, "Spacing of the thin slices inside a layer (mm)")
+      ->check(in_range(0.0, true, 1e308, "mm"))
+      ->capture_default_str();
+  cmd.add_option("--tolerance", o.tolerance_mm, "Allowed deviation of a layer's edge from the surface (mm)")
+      ->check(in_range(0.0, true, 1e308, "mm"))
+      ->capture_default_str();
+  cmd.add_option("--tilt-max", o.tilt_max_deg, "The machine's largest jet tilt from vertical (degrees)")
+      ->check(in_range(0.0, false, 89.0, "degrees"))
+      ->capture_default_str();
+  cmd.add_option("--side", o.side, "Which side of the surface cuts may lie on")
+      ->check(CLI::IsMember({"outside", "inside", "mixed"}))
+      ->capture_default_str();
+  cmd.add_option("--strategy", o.strategy, "How layer edges are cut: curved form, one sloped chord, vertical")
+      ->check(CLI::IsMember({"curved", "sloped", "vertical"}))
+      ->capture_default_str();
+  cmd.add_option("--layering", o.layering, "Layer choice: optimal (dynamic programme) or greedy (the paper's rule)")
+      ->check(CLI::IsMember({"optimal", "greedy"}))
+      ->capture_default_str();
+  cmd.add_option("--deviation-step", o.deviation_step_mm, "Spacing of the sections the deviation is integrated over (mm)")
+      ->check(in_range(0.0, true, 1e308, "mm"))
+      ->capture_default_str();
+  cmd.add_option("--out", o.out_dir, "Folder for stack.stl and report.json (created if missing)")->required();
+  cmd.add_flag("--json", o.json, "Print the report as JSON on stdout instead of the tables");
+  cmd.add_flag("--all-rows", o.all_rows, "Print every layer in the table");
+  cmd.footer(
+      "All plan lengths (--stock, --bond, --sub-slice, --tolerance, --deviation-step) are in mm and\n"
+      "--tilt-max in degrees, whatever --units says: --units is the unit of the model file only.\n"
+      "Exit status: 0 planned, 1 the model, the stock file or the output folder failed, 2 usage error.");
+}
+
+std::expected<PlanSettings, Error> resolve_plan_settings(const PlanOptions& o) {
+  PlanSettings s;
+  if (!o.stock_file.empty()) {
+    auto stock = read_stock_file(o.stock_file);
+    if (!stock) return std::unexpected(stock.error());
+    s.stock = std::move(*stock);
+    s.stock_source = o.stock_file;
+  }
+  if (o.stock_list_given || o.stock_file.empty()) {
+    auto list = parse_thickness_list(o.stock_list);
+    if (!list) return std::unexpected(Error{ErrorCode::invalid_argument, "--stock: " + list.error()});
+    if (!o.stock_file.empty())
+      s.warnings.push_back(fmt::format("--stock {} replaces the sheets of {}", o.stock_list, o.stock_file));
+    s.stock = sheets_of_unknown_size(*list);
+    s.stock_source = o.stock_list_given ? "--stock" : "default";
+  }
+  s.thicknesses_mm = stock_thicknesses(s.stock);
+  s.bond_mm = o.bond_mm;
+  s.sub_slice_mm = o.sub_slice_mm;
+  s.tolerance_mm = o.tolerance_mm;
+  s.tilt_max_rad = o.tilt_max_deg * std::numbers::pi / 180.0;  // the one degree → radian conversion
+  s.deviation_step_mm = o.deviation_step_mm;
+  s.side = side_from(o.side);
+  s.strategy = strategy_from(o.strategy);
+  s.layering = layering_from(o.layering);
+  const double thinnest = s.thicknesses_mm.front();
+  if (s.sub_slice_mm > thinnest)
+    s.warnings.push_back(fmt::format("--sub-slice {} mm is more than the thinnest sheet ({} mm): layers of that "
+                                     "sheet are read at their faces only",
+                                     s.sub_slice_mm, thinnest));
+  if (s.deviation_step_mm > 0.5 * thinnest)
+    s.warnings.push_back(fmt::format("--deviation-step {} mm is coarse for {} mm sheets: the deviation volume is "
+                                     "approximate",
+                                     s.deviation_step_mm, thinnest));
+  return s;
+}
+
+LayeringParams layering_params(const PlanSettings& s) {
+  LayeringParams p;
+  p.thicknesses_mm = s.thicknesses_mm;
+  p.bond_mm = s.bond_mm;
+  p.sub_slice_mm = s.sub_slice_mm;
+  p.tolerance_mm = s.tolerance_mm;
+  p.method = s.layering;
+  p.fit.side = s.side;
+  p.fit.strategy = s.strategy;
+  p.fit.tilt_max_rad = s.tilt_max_rad;
+  return p;
+}
+
+BevelParams bevel_params(const PlanSettings& s, BevelStrategy strategy) {
+  BevelParams p;
+  p.fit.side = s.side;
+  p.fit.strategy = strategy;
+  p.fit.tilt_max_rad = s.tilt_max_rad;
+  p.sub_slice_mm = s.sub_slice_mm;
+  p.tolerance_mm = s.tolerance_mm;
+  return p;
+}
+
+DeviationParams deviation_params(const PlanSettings& s) {
+  DeviationParams p;
+  p.step_mm = s.deviation_step_mm;
+  return p;
+}
+
+}  // namespace lamina::cli
