@@ -1,0 +1,64 @@
+#pragma once
+// Nesting parts on stock sheets (paper section 4 + true-shape nesting). Sheets of one thickness
+// take the parts of the layers of that thickness; thin sheets come first (the paper cuts thin
+// before thick). A placement maps a part's layer XY into the sheet frame:
+//   sheet_xy = R(rotation_rad) · layer_xy + offset_mm
+// Sheet frame: origin at the sheet's corner, x along its length, y along its width.
+#include "lamina/core/error.hpp"
+#include "lamina/core/parts.hpp"
+#include "lamina/core/stock.hpp"
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <expected>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace lamina {
+
+enum class NestMethod : std::uint8_t { matrix, shape };
+const char* nest_method_name(NestMethod method);
+
+struct NestParams {
+  NestMethod method = NestMethod::matrix;
+  double spacing_mm = 6.0;   // clear gap between part footprints (leads and pierces of outer loops sit in it)
+  double margin_mm = 10.0;   // clear band along the sheet's edges (clamps, the skeleton's frame)
+  // Rotations tried by shape nesting, degrees at the edge, radians here. Matrix nesting uses 0 or 90°.
+  std::vector<double> rotations_rad{0.0, 1.5707963267948966, 3.141592653589793, 4.71238898038469};
+  bool parallel = true;
+};
+
+struct Placement {
+  int part = -1;              // index into the parts span given to nest_parts
+  double rotation_rad = 0.0;  // about +Z, applied before offset_mm
+  Eigen::Vector2d offset_mm = Eigen::Vector2d::Zero();
+};
+
+struct NestedSheet {
+  int index = 0;             // 1-based, in cutting order (thin before thick)
+  int stock_index = -1;      // which Stock::sheets entry it was taken from
+  double thickness_mm = 0.0;
+  double width_mm = 0.0;     // sheet y extent
+  double length_mm = 0.0;    // sheet x extent
+  std::string material;
+  std::vector<Placement> placements;  // in the order the parts are numbered on the sheet
+  double utilisation = 0.0;  // part area / sheet area
+};
+
+struct Nest {
+  std::vector<NestedSheet> sheets;
+};
+
+// Place every part on a sheet of its thickness. Errors (ErrorCode::invalid_argument) name the
+// thickness and what is missing: no sheet of that thickness, a sheet without a known size, a part
+// larger than every sheet of its thickness, or not enough sheets (count) for all its parts.
+// A stock count of 0 means the count is not known: as many sheets as needed.
+std::expected<Nest, Error> nest_parts(std::span<const Part> parts, const Stock& stock, const NestParams& params);
+
+// A part's footprint placed on its sheet.
+Polygon2 placed_footprint(const Part& part, const Placement& placement);
+Eigen::Vector2d place_point(const Placement& placement, const Eigen::Vector2d& layer_xy);
+
+}  // namespace lamina

@@ -1,0 +1,46 @@
+#pragma once
+// Post-processors (DESIGN step 8): a sheet's toolpath → a G-code program in a controller's dialect.
+// Compact lines (modal words omitted, trailing zeros stripped, no spaces) because at 115200 baud
+// every byte is machine time. Contours are marked with a comment `(CONTOUR n ...)` at their pierce
+// so the machine link can resume at the start of a contour.
+#include "lamina/core/error.hpp"
+#include "lamina/core/kinematics.hpp"
+#include "lamina/core/toolpath.hpp"
+
+#include <cstddef>
+#include <cstdint>
+#include <expected>
+#include <string>
+#include <vector>
+
+namespace lamina {
+
+enum class PostDialect : std::uint8_t { grblhal, fanuc, linuxcnc };
+const char* post_dialect_name(PostDialect dialect);
+
+struct PostParams {
+  PostDialect dialect = PostDialect::grblhal;
+  int linear_decimals = 3;   // mm
+  int angular_decimals = 4;  // degrees (4: 1e-4° on a 150 mm pivot is 0.26 µm at the tip)
+  std::string jet_on = "M3";   // M-code(s) that open the cutting-head valve
+  std::string jet_off = "M5";
+  int program_number = 1000;   // fanuc: O number
+  std::string title;           // first comment line (part of the job, sheet, thickness, material)
+};
+
+struct PostedProgram {
+  std::string text;
+  std::size_t lines = 0;
+  std::size_t motion_lines = 0;        // G0/G1 lines
+  std::size_t five_axis_moves = 0;     // motion lines that carry A or C
+  std::size_t five_axis_bytes = 0;     // their bytes, newline included
+  std::vector<std::size_t> contour_lines;  // 1-based line of each contour's marker, per ToolContour
+  std::vector<AxisPose> poses;         // machine axes at the end of every ToolMove (same order)
+};
+
+// Errors name the move (contour, index) that the machine cannot reach: tilt beyond the A limits,
+// a contour whose C travel exceeds a limited C range.
+std::expected<PostedProgram, Error> post_program(const SheetToolpath& toolpath, const HeadKinematics& head,
+                                                 const PostParams& params);
+
+}  // namespace lamina

@@ -1,0 +1,101 @@
+#pragma once
+// Toolpaths of one nested sheet (DESIGN step 6): the order of the cuts, pierces, lead-ins and
+// lead-outs, trim passes before the pass that frees a part, microjoints, kerf compensation in
+// 5 axes, feeds, and the cut time. Everything is in the sheet frame: origin at the sheet's corner,
+// z = 0 on the sheet's top face, its bottom at z = −thickness. The tool tip is where the jet's
+// axis crosses the top face; the machine's standoff is above it and belongs to the kinematics.
+#include "lamina/core/bevel.hpp"
+#include "lamina/core/error.hpp"
+#include "lamina/core/feed.hpp"
+#include "lamina/core/nest.hpp"
+#include "lamina/core/parts.hpp"
+
+#include <Eigen/Core>
+
+#include <cstddef>
+#include <cstdint>
+#include <expected>
+#include <span>
+#include <vector>
+
+namespace lamina {
+
+enum class MoveKind : std::uint8_t { rapid, pierce, lead_in, cut, lead_out };
+const char* move_kind_name(MoveKind kind);
+
+// One move of the tool tip, from the previous move's end to this one's end. The tool axis turns
+// linearly (and is renormalised) along the move. A pierce stands still for dwell_s with the jet on.
+struct ToolMove {
+  MoveKind kind = MoveKind::rapid;
+  Eigen::Vector3d tip_mm = Eigen::Vector3d::Zero();
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();  // unit, tip → nozzle
+  double feed_mm_per_s = 0.0;  // tool-tip speed; 0 for rapids (the machine's rapid rate)
+  double dwell_s = 0.0;        // pierce only
+  bool jet_on = false;         // the jet's state during the move (on from the pierce to the end of the lead-out)
+  int contour = -1;            // index into SheetToolpath::contours; -1 for rapids between contours
+};
+
+// One cut from pierce to lead-out: a whole pass around an outline, or a run of it (a trim run,
+// or a segment between microjoints).
+struct ToolContour {
+  int placement = -1;  // index into NestedSheet::placements
+  int part = -1;       // index into the parts span
+  int outline = -1;    // index into LayerPlan::outlines
+  int pass = -1;       // index into LayerOutline::passes
+  bool is_hole = false;
+  bool frees = false;   // part of the pass that separates the outline's inside from its outside
+  bool closed = false;  // goes all the way round (no tabs, not a trim run)
+  std::size_t first_move = 0, end_move = 0;  // [first, end) into SheetToolpath::moves: pierce … lead-out
+  Eigen::Vector2d pierce_mm = Eigen::Vector2d::Zero();
+};
+
+// A microjoint left uncut on a freeing pass: from → to along the outline (sheet frame, top face).
+struct Microjoint {
+  int placement = -1;
+  Eigen::Vector2d from_mm = Eigen::Vector2d::Zero(), to_mm = Eigen::Vector2d::Zero();
+};
+
+struct CutTime {
+  double cutting_s = 0.0;   // lead-ins, cuts, lead-outs at their feeds
+  double rapid_s = 0.0;     // rapids at rapid_mm_per_s (straight-line distance)
+  double pierce_s = 0.0;    // pierce dwells
+  double total_s = 0.0;
+  double cut_length_mm = 0.0, rapid_length_mm = 0.0;
+  int pierces = 0;
+};
+
+struct SheetToolpath {
+  int sheet = 0;  // NestedSheet::index
+  double thickness_mm = 0.0;
+  std::vector<ToolMove> moves;  // starts with a rapid from the park position, ends with one back to it
+  std::vector<ToolContour> contours;
+  std::vector<Microjoint> microjoints;
+  CutTime time;
+};
+
+struct ToolpathParams {
+  double kerf_mm = 0.9;            // the same kerf the parts' footprints were made with
+  double lead_in_mm = 3.0;         // pierce point to the contour, into the scrap (shortened to fit small holes)
+  double lead_out_mm = 1.5;        // from the contour's end back into the scrap
+  double pierce_dwell_s = 1.0;     // jet on, standing still, before the lead-in starts
+  double safe_z_mm = 10.0;         // rapids travel at this height above the sheet's top
+  int microjoints = 0;             // per outer outline's freeing pass, evenly spaced by length
+  double microjoint_width_mm = 0.6;  // uncut length of one microjoint
+  double rapid_mm_per_s = 250.0;
+  // Slow-down into sharp corners: a corner turning more than corner_angle_rad (in the top face) is
+  // entered and left at feed · max(corner_min_fraction, cos(turn/2)).
+  double corner_angle_rad = 0.5235987755982988;  // 30°
+  double corner_min_fraction = 0.25;
+  bool part_on_right = true;  // outer loops clockwise, holes counter-clockwise (the jet's good side)
+  Eigen::Vector2d park_mm = Eigen::Vector2d::Zero();  // where the head waits before and after the sheet
+  JetSetup jet;
+  FeedParams feed;
+};
+
+// The toolpath of one nested sheet. material is the sheet's; plan and parts are what the nest was
+// made from. Holes of a part are cut before its outer outline; trim runs before the freeing pass.
+std::expected<SheetToolpath, Error> plan_sheet_toolpath(const BevelPlan& plan, std::span<const Part> parts,
+                                                        const NestedSheet& sheet, const Material& material,
+                                                        const ToolpathParams& params);
+
+}  // namespace lamina
