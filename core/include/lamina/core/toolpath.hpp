@@ -29,7 +29,12 @@ struct ToolMove {
   MoveKind kind = MoveKind::rapid;
   Eigen::Vector3d tip_mm = Eigen::Vector3d::Zero();
   Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();  // unit, tip → nozzle
-  double feed_mm_per_s = 0.0;  // tool-tip speed; 0 for rapids (the machine's rapid rate)
+  double feed_mm_per_s = 0.0;  // the jet's cutting speed; 0 for rapids (the machine's rapid rate)
+  // How long the move takes. Cutting moves: the longer of the jet's travel at the top and at the
+  // bottom face, at feed_mm_per_s — so a move that only turns the head about the tip (a fan of
+  // lines at a corner) still takes the time its bottom point needs. Rapids: distance / rapid rate.
+  // Pierces: dwell_s. Posts derive F from this: G93 F = 1/minutes; G94 F = tip distance/minutes.
+  double duration_s = 0.0;
   double dwell_s = 0.0;        // pierce only
   bool jet_on = false;         // the jet's state during the move (on from the pierce to the end of the lead-out)
   int contour = -1;            // index into SheetToolpath::contours; -1 for rapids between contours
@@ -45,7 +50,10 @@ struct ToolContour {
   bool is_hole = false;
   bool frees = false;   // part of the pass that separates the outline's inside from its outside
   bool closed = false;  // goes all the way round (no tabs, not a trim run)
-  std::size_t first_move = 0, end_move = 0;  // [first, end) into SheetToolpath::moves: pierce … lead-out
+  // [first, end) into SheetToolpath::moves: the rapid over the pierce point at safe height, the rapid
+  // down, pierce, lead-in, cuts, lead-out, the rapid up. A link resuming "at the start of the contour"
+  // starts with the first of them.
+  std::size_t first_move = 0, end_move = 0;
   Eigen::Vector2d pierce_mm = Eigen::Vector2d::Zero();
 };
 
