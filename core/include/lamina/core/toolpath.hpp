@@ -75,7 +75,7 @@ struct CutTime {
 struct SheetToolpath {
   int sheet = 0;  // NestedSheet::index
   double thickness_mm = 0.0;
-  std::vector<ToolMove> moves;  // starts with a rapid from the park position, ends with one back to it
+  std::vector<ToolMove> moves;  // starts with a rapid to the park position at safe height, ends with one back to it
   std::vector<ToolContour> contours;
   std::vector<Microjoint> microjoints;
   CutTime time;
@@ -89,6 +89,7 @@ struct ToolpathParams {
   double safe_z_mm = 10.0;         // rapids travel at this height above the sheet's top
   int microjoints = 0;             // per outer outline's freeing pass, evenly spaced by length
   double microjoint_width_mm = 0.6;  // uncut length of one microjoint
+  double dowel_diameter_mm = 6.0;    // of the parts' dowel holes (Part::dowels_mm), cut vertical
   double rapid_mm_per_s = 250.0;
   // Slow-down into sharp corners: a corner turning more than corner_angle_rad (in the top face) is
   // entered and left at feed · max(corner_min_fraction, cos(turn/2)).
