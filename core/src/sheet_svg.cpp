@@ -106,21 +106,22 @@ Vec2 centroid(const Polygon2& ring) {
 }
 
 struct LabelSpot {
-  Vec2 at = Vec2::Zero();  // layer XY
+  Vec2 at = Vec2::Zero();
   double room_x = 0.0, room_y = 0.0;  // material around it, along x and y
 };
 
-// Where a part's number goes, in layer XY: the footprint's centroid when it lies in the part's
-// material (top contour minus holes); otherwise the middle of the widest horizontal run of
-// material (nearest the centroid's height), centred vertically there.
-LabelSpot label_spot(const Part& part, const PartRings& r) {
-  const Polygon2& outer = r.outer_top.size() >= 3 ? r.outer_top : part.footprint_mm;
+// Where a part's number goes, in the frame of its arguments (the sheet's: the text is horizontal
+// there): the footprint's centroid when it lies in the part's material (top contour minus holes);
+// otherwise the middle of the widest horizontal run of material (nearest the centroid's height),
+// centred vertically there.
+LabelSpot label_spot(const Polygon2& footprint, const PartRings& r) {
+  const Polygon2& outer = r.outer_top.size() >= 3 ? r.outer_top : footprint;
   if (outer.empty()) return {};
   std::vector<const Polygon2*> rings{&outer};
   for (const auto& h : r.holes_top) {
     if (h.size() >= 3) rings.push_back(&h);
   }
-  const Vec2 c = centroid(part.footprint_mm.size() >= 3 ? part.footprint_mm : outer);
+  const Vec2 c = centroid(footprint.size() >= 3 ? footprint : outer);
   const auto hx = span_at(rings, c, 0);
   const auto hy = span_at(rings, c, 1);
   if (hx && hy) return {c, hx->second - hx->first, hy->second - hy->first};
@@ -187,15 +188,22 @@ void circle(std::string& svg, const char* cls, const Vec2& c, double r) {
 // One placement: footprint, bottom then top contours, dowel holes. Its label goes to labels.
 void draw_part(std::string& svg, std::string& labels, int k, const BevelPlan& plan, const Part& part,
                const Placement& pl, const Scale& s, const SheetSvgParams& params) {
-  const auto rings = part_rings(plan, part);
+  auto rings = part_rings(plan, part);
+  if (rings) {
+    rings->outer_top = to_sheet(pl, rings->outer_top);
+    rings->outer_bottom = to_sheet(pl, rings->outer_bottom);
+    for (auto& h : rings->holes_top) h = to_sheet(pl, h);
+    for (auto& h : rings->holes_bottom) h = to_sheet(pl, h);
+  }
+  const Polygon2 footprint = to_sheet(pl, part.footprint_mm);
   auto out = std::back_inserter(svg);
   fmt::format_to(out, "<g class=\"part\" id=\"part-{}\">\n", k + 1);
-  polygon(svg, "footprint", to_sheet(pl, part.footprint_mm));
+  polygon(svg, "footprint", footprint);
   if (rings) {
-    polygon(svg, "bottom-outer", to_sheet(pl, rings->outer_bottom));
-    for (const auto& h : rings->holes_bottom) polygon(svg, "bottom-hole", to_sheet(pl, h));
-    polygon(svg, "top-outer", to_sheet(pl, rings->outer_top));
-    for (const auto& h : rings->holes_top) polygon(svg, "top-hole", to_sheet(pl, h));
+    polygon(svg, "bottom-outer", rings->outer_bottom);
+    for (const auto& h : rings->holes_bottom) polygon(svg, "bottom-hole", h);
+    polygon(svg, "top-outer", rings->outer_top);
+    for (const auto& h : rings->holes_top) polygon(svg, "top-hole", h);
   }
   if (params.dowel_diameter_mm > 0.0) {
     for (const auto& d : part.dowels_mm) circle(svg, "dowel", to_sheet(pl, d), 0.5 * params.dowel_diameter_mm);
@@ -203,12 +211,12 @@ void draw_part(std::string& svg, std::string& labels, int k, const BevelPlan& pl
   svg += "</g>\n";
 
   const std::string text = fmt::format("L{}-{}", part.layer, part.island);
-  const LabelSpot spot = rings ? label_spot(part, *rings) : LabelSpot{centroid(part.footprint_mm), s.font, s.font};
+  const LabelSpot spot = rings ? label_spot(footprint, *rings) : LabelSpot{centroid(footprint), s.font, s.font};
   // As large as the legend's text, but fitting the material around the spot.
   const double fit_x = spot.room_x / (0.65 * static_cast<double>(text.size()) + 0.5);
   const double fit_y = 0.7 * spot.room_y;
   const double font = std::max(0.5, std::min({s.font, fit_x, fit_y}));
-  const Vec2 at = to_sheet(pl, spot.at);
+  const Vec2& at = spot.at;
   // The drawing's group flips y; the label flips back about its own anchor to stay upright.
   fmt::format_to(std::back_inserter(labels),
                  "<text class=\"label\" id=\"label-{}\" transform=\"translate({} {}) scale(1 -1)\" font-size=\"{}\" dy=\"0.35em\">{}</text>\n",

@@ -110,7 +110,7 @@ ToolMove move(MoveKind kind, const Vec2& xy, double z, int contour) {
 }
 
 // Per placement: the hole, then the outer; each a rapid over and down, pierce, lead-in, two
-// cuts, lead-out. Microjoints: one on each outer.
+// cuts, lead-out, rapid up. Microjoints: one on each outer.
 SheetToolpath make_toolpath(const NestedSheet& sheet) {
   SheetToolpath tp;
   tp.sheet = sheet.index;
@@ -121,9 +121,10 @@ SheetToolpath make_toolpath(const NestedSheet& sheet) {
       const Vec2 start = place(pl, hole ? Vec2(20, 15) : Vec2(20, 0));
       const Vec2 pierce = place(pl, hole ? Vec2(20, 18) : Vec2(20, -3));
       const int c = static_cast<int>(tp.contours.size());
-      tp.moves.push_back(move(MoveKind::rapid, pierce, 10.0, -1));
-      tp.moves.push_back(move(MoveKind::rapid, pierce, 0.0, -1));
       ToolContour tc;
+      tc.first_move = tp.moves.size();  // the contour's moves include its rapids (toolpath.hpp)
+      tp.moves.push_back(move(MoveKind::rapid, pierce, 10.0, c));
+      tp.moves.push_back(move(MoveKind::rapid, pierce, 0.0, c));
       tc.placement = k;
       tc.part = pl.part;
       tc.outline = hole ? 1 : 0;
@@ -131,15 +132,14 @@ SheetToolpath make_toolpath(const NestedSheet& sheet) {
       tc.is_hole = hole;
       tc.frees = tc.closed = true;
       tc.pierce_mm = pierce;
-      tc.first_move = tp.moves.size();
       tp.moves.push_back(move(MoveKind::pierce, pierce, 0.0, c));
       tp.moves.push_back(move(MoveKind::lead_in, start, 0.0, c));
       tp.moves.push_back(move(MoveKind::cut, place(pl, hole ? Vec2(25, 15) : Vec2(40, 0)), 0.0, c));
       tp.moves.push_back(move(MoveKind::cut, start, 0.0, c));
       tp.moves.push_back(move(MoveKind::lead_out, place(pl, hole ? Vec2(21, 16.5) : Vec2(21, -1.5)), 0.0, c));
+      tp.moves.push_back(move(MoveKind::rapid, tp.moves.back().tip_mm.head<2>(), 10.0, c));
       tc.end_move = tp.moves.size();
       tp.contours.push_back(tc);
-      tp.moves.push_back(move(MoveKind::rapid, tp.moves.back().tip_mm.head<2>(), 10.0, -1));
     }
     tp.microjoints.push_back(Microjoint{k, place(pl, {40, 20}), place(pl, {40, 20.6})});
   }
@@ -336,9 +336,11 @@ TEST(SheetSvg, PiercesLeadsMicrojointsAndRapids) {
   ASSERT_EQ(leads_out.size(), f.tp.contours.size());
   for (std::size_t i = 0; i < leads_in.size(); ++i) {
     const auto& c = f.tp.contours[i];
-    const Vec2 start = f.tp.moves[c.first_move + 1].tip_mm.head<2>();
+    // Moves of a contour: rapid over, rapid down, pierce, lead-in, cut, cut, lead-out, rapid up.
+    ASSERT_EQ(c.end_move - c.first_move, 8u);
+    const Vec2 start = f.tp.moves[c.first_move + 3].tip_mm.head<2>();
     expect_ring(*leads_in[i], {c.pierce_mm, start}, "lead-in " + std::to_string(i));
-    const Vec2 from = f.tp.moves[c.end_move - 2].tip_mm.head<2>(), to = f.tp.moves[c.end_move - 1].tip_mm.head<2>();
+    const Vec2 from = f.tp.moves[c.end_move - 3].tip_mm.head<2>(), to = f.tp.moves[c.end_move - 2].tip_mm.head<2>();
     expect_ring(*leads_out[i], {from, to}, "lead-out " + std::to_string(i));
   }
   EXPECT_EQ(tp.find("line", "microjoint").size(), f.tp.microjoints.size());
