@@ -185,20 +185,30 @@ std::expected<PostedProgram, Error> post_program(const SheetToolpath& toolpath, 
     if (!any_changed && !force) continue;  // nothing the controller would see
     std::string line;
     std::string f;
-    if (!head.rtcp && turns) {
-      // Inverse time: F = 1 / minutes of the move, the minutes from the tip's path at the tip's feed.
-      const Eigen::Vector3d from = i > 0 ? moves[i - 1].tip_mm : m.tip_mm;
-      double distance = (m.tip_mm - from).norm();
-      if (distance < still_tip_mm && i > 0) {
+    // The move's time: the toolpath's duration_s (the longer of the jet's travel at the top and the
+    // bottom face); a toolpath without durations: the tip's distance at the feed.
+    const Eigen::Vector3d from = i > 0 ? moves[i - 1].tip_mm : m.tip_mm;
+    const double tip_distance = (m.tip_mm - from).norm();
+    double seconds = m.duration_s;
+    if (!(seconds > 0.0)) {
+      double distance = tip_distance;
+      if (distance < still_tip_mm && i > 0) {  // a turn about the tip: the pivot's arc
         const TipPose a = forward_kinematics(poses[i - 1], head), b = forward_kinematics(p, head);
         distance = head.pivot_mm * std::acos(std::clamp(a.axis.dot(b.axis), -1.0, 1.0));
       }
-      const double minutes = std::max(distance, still_tip_mm) / m.feed_mm_per_s / s_per_min;
+      seconds = std::max(distance, still_tip_mm) / m.feed_mm_per_s;
+    }
+    const double minutes = seconds / s_per_min;
+    if (!head.rtcp && turns) {
+      // Inverse time: F = 1 / minutes of the move.
       f = format_significant(1.0 / minutes, inverse_time_digits, 3, kp);
       if (!inverse_time) line += "G93";
       inverse_time = true;
     } else {
-      f = format_number(m.feed_mm_per_s * s_per_min, params.feed_decimals, kp);
+      // mm/min of the tip (RTCP: the controller holds the tip's speed; without RTCP the head does
+      // not turn, so X Y Z move as the tip). A turn about a still tip keeps the cutting feed.
+      const double mm_per_min = tip_distance >= still_tip_mm ? tip_distance / minutes : m.feed_mm_per_s * s_per_min;
+      f = format_number(mm_per_min, params.feed_decimals, kp);
       if (inverse_time) {
         line += "G94";
         inverse_time = false;

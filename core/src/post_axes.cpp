@@ -81,8 +81,19 @@ std::expected<std::vector<AxisPose>, Error> plan_machine_axes(const SheetToolpat
   const bool limited = std::isfinite(head.c_min_rad) || std::isfinite(head.c_max_rad);
   if (!limited || moves.empty()) return poses;
 
-  // 2. Limited C: one 2πk shift per contour, chosen so the whole contour is in range and its
-  // first C is nearest to where the head was.
+  // 2. Limited C: per contour, one of the two branches of the inverse — (A, C) as it came, or
+  // (−A, C + π) all along — and one 2πk shift, chosen so the whole contour is in range and its first
+  // C is nearest to where the head was.
+  auto solve_run = [&](std::size_t first, std::size_t end, double prev) -> std::optional<std::vector<AxisPose>> {
+    std::vector<AxisPose> run;
+    for (std::size_t m = first; m < end; ++m) {
+      auto pose = inverse_kinematics(moves[m].tip_mm, moves[m].axis, prev, head);
+      if (!pose) return std::nullopt;
+      prev = pose->c_rad;
+      run.push_back(*pose);
+    }
+    return run;
+  };
   std::vector<double> shift(toolpath.contours.size(), 0.0);
   std::vector<std::size_t> order(toolpath.contours.size());
   for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
@@ -92,30 +103,51 @@ std::expected<std::vector<AxisPose>, Error> plan_machine_axes(const SheetToolpat
   std::optional<double> last_c;  // shifted C at the end of the previous contour
   for (std::size_t ci : order) {
     const ToolContour& c = toolpath.contours[ci];
-    double lo = poses[c.first_move].c_rad, hi = lo;
-    for (std::size_t i = c.first_move; i < c.end_move; ++i) {
-      lo = std::min(lo, poses[i].c_rad);
-      hi = std::max(hi, poses[i].c_rad);
+    std::vector<std::vector<AxisPose>> options;
+    options.emplace_back(poses.begin() + static_cast<std::ptrdiff_t>(c.first_move),
+                         poses.begin() + static_cast<std::ptrdiff_t>(c.end_move));
+    if (auto flipped = solve_run(c.first_move, c.end_move, poses[c.first_move].c_rad + std::numbers::pi);
+        flipped && std::abs(flipped->front().a_rad - options[0].front().a_rad) > 1e-12)
+      options.push_back(std::move(*flipped));
+    std::optional<std::size_t> best;
+    double best_k = 0.0, best_cost = 0.0, lo0 = 0.0, hi0 = 0.0;
+    for (std::size_t o = 0; o < options.size(); ++o) {
+      double lo = options[o].front().c_rad, hi = lo;
+      for (const AxisPose& p : options[o]) {
+        lo = std::min(lo, p.c_rad);
+        hi = std::max(hi, p.c_rad);
+      }
+      if (o == 0) lo0 = lo, hi0 = hi;
+      const double k_lo = std::ceil((head.c_min_rad - lo) / two_pi - 1e-12);
+      const double k_hi = std::floor((head.c_max_rad - hi) / two_pi + 1e-12);
+      if (k_lo > k_hi) continue;
+      const double first = options[o].front().c_rad;
+      const double target = last_c.value_or(0.0);
+      const double k = std::clamp(std::round((target - first) / two_pi), k_lo, k_hi);
+      const double cost = std::abs(first + two_pi * k - target);
+      if (!best || cost < best_cost - 1e-12) {
+        best = o;
+        best_k = k;
+        best_cost = cost;
+      }
     }
-    const double k_lo = std::ceil((head.c_min_rad - lo) / two_pi - 1e-12);
-    const double k_hi = std::floor((head.c_max_rad - hi) / two_pi + 1e-12);
-    if (k_lo > k_hi)
+    if (!best)
       return std::unexpected(Error{
           ErrorCode::invalid_argument,
           fmt::format("contour {}: C travels {:.3f} deg ({:.3f} to {:.3f}), which does not fit the C range "
-                      "[{:.3f}, {:.3f}] deg at any turn",
-                      ci, (hi - lo) * deg_per_rad, lo * deg_per_rad, hi * deg_per_rad, head.c_min_rad * deg_per_rad,
-                      head.c_max_rad * deg_per_rad)});
-    const double first = poses[c.first_move].c_rad;
-    const double target = last_c.value_or(0.0);
-    const double k = std::clamp(std::round((target - first) / two_pi), k_lo, k_hi);
-    shift[ci] = two_pi * k;
+                      "[{:.3f}, {:.3f}] deg at any turn of either head solution",
+                      ci, (hi0 - lo0) * deg_per_rad, lo0 * deg_per_rad, hi0 * deg_per_rad,
+                      head.c_min_rad * deg_per_rad, head.c_max_rad * deg_per_rad)});
+    std::copy(options[*best].begin(), options[*best].end(), poses.begin() + static_cast<std::ptrdiff_t>(c.first_move));
+    shift[ci] = two_pi * best_k;
     last_c = poses[c.end_move - 1].c_rad + shift[ci];
   }
 
-  // 3. Apply: contour moves take their contour's shift; a run of rapids between two contours takes
-  // the previous contour's shift until the head is up at travel height, then the next one's (the
-  // rewind is the first move that starts at the run's highest point).
+  // 3. Apply: contour moves take their contour's shift. A contour starts with the rapid over its
+  // pierce point at safe height, so the rewind is that rapid. Moves outside every contour (the
+  // park rapids; or a toolpath whose contours start at the pierce) take the previous contour's
+  // shift until the head is up at travel height, then the next one's (the rewind is the first move
+  // that starts at the run's highest point).
   std::vector<double> applied(moves.size(), 0.0);
   std::vector<bool> assigned(moves.size(), false);
   for (std::size_t ci = 0; ci < toolpath.contours.size(); ++ci)

@@ -83,7 +83,8 @@ inline std::expected<Program, std::string> read_gcode(std::string_view text, con
   Program prog;
   bool inverse_time = false, tcp = false, jet = false;
   int motion = -1;
-  std::optional<double> feed;  // F defined for the next G1
+  double feed = 0;             // the F in force
+  bool feed_defined = false;   // F defined for the next G1
   double pos[5] = {0, 0, 0, 0, 0};
   bool known[5] = {false, false, false, false, false};
   double dwell = 0;
@@ -229,6 +230,7 @@ inline std::expected<Program, std::string> read_gcode(std::string_view text, con
           break;
         case 'F':
           feed = w.value;
+          feed_defined = true;
           f_on_line = true;
           break;
         case 'X': next[0] = w.value; axis_words = true; known[0] = true; break;
@@ -239,7 +241,7 @@ inline std::expected<Program, std::string> read_gcode(std::string_view text, con
         default: return fail(std::string("unknown word ") + w.letter);
       }
     }
-    if (mode_switch_to_94 && !f_on_line) feed.reset();
+    if (mode_switch_to_94 && !f_on_line) feed_defined = false;
     if (is_dwell) {
       if (!p_word || axis_words || motion_word) return fail("G4 needs P alone");
       dwell += opt.fanuc ? *p_word / 1000.0 : *p_word;
@@ -256,7 +258,7 @@ inline std::expected<Program, std::string> read_gcode(std::string_view text, con
     if (motion == 0 && inverse_time) return fail("G0 in G93 (Grbl then wants an F)");
     if (motion == 1) {
       if (inverse_time && !f_on_line) return fail("G1 in G93 without F");
-      if (!feed) return fail("G1 without a defined F");
+      if (!feed_defined) return fail("G1 without a defined F");
     }
     for (int k = 0; k < 5; ++k) pos[k] = next[k];
     MotionLine m;
@@ -265,7 +267,7 @@ inline std::expected<Program, std::string> read_gcode(std::string_view text, con
     m.inverse_time = inverse_time;
     m.tcp = tcp;
     m.x = pos[0], m.y = pos[1], m.z = pos[2], m.a_deg = pos[3], m.c_deg = pos[4];
-    m.f = feed.value_or(0.0);
+    m.f = feed_defined ? feed : 0.0;
     m.f_on_line = f_on_line;
     m.has_rotary = rotary;
     m.jet_on = jet;

@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <random>
@@ -73,10 +74,19 @@ inline ContourSpec random_walk(unsigned seed, int n, double max_tilt_rad) {
   return c;
 }
 
+// Where the jet line through tip along axis crosses the sheet's bottom face.
+inline Eigen::Vector3d bottom_point(const Eigen::Vector3d& tip, const Eigen::Vector3d& axis, double thickness) {
+  return tip - axis * (thickness / axis.z());
+}
+
+// The layout of toolpath.hpp: a contour's moves are the rapid over its pierce point at safe height,
+// the rapid down, pierce, lead-in, cuts, lead-out and the rapid up. Cutting moves take the longer
+// of the jet's travel at the top and bottom faces at the feed.
 inline lamina::SheetToolpath make_toolpath(const std::vector<ContourSpec>& specs, double safe_z = 10.0) {
   using lamina::MoveKind;
   lamina::SheetToolpath tp;
   tp.thickness_mm = 6.0;
+  constexpr double rapid_mm_per_s = 250.0;
   auto add = [&](MoveKind kind, const Eigen::Vector3d& tip, const Eigen::Vector3d& axis, double feed, bool jet,
                  int contour, double dwell = 0.0) {
     lamina::ToolMove m;
@@ -87,6 +97,19 @@ inline lamina::SheetToolpath make_toolpath(const std::vector<ContourSpec>& specs
     m.jet_on = jet;
     m.contour = contour;
     m.dwell_s = dwell;
+    if (!tp.moves.empty()) {
+      const lamina::ToolMove& prev = tp.moves.back();
+      const double top = (m.tip_mm - prev.tip_mm).norm();
+      if (kind == MoveKind::rapid) {
+        m.duration_s = top / rapid_mm_per_s;
+      } else if (kind == MoveKind::pierce) {
+        m.duration_s = dwell;
+      } else {
+        const double bottom = (bottom_point(m.tip_mm, m.axis, tp.thickness_mm) -
+                               bottom_point(prev.tip_mm, prev.axis, tp.thickness_mm)).norm();
+        m.duration_s = std::max(top, bottom) / feed;
+      }
+    }
     tp.moves.push_back(m);
   };
   const Eigen::Vector3d up(0, 0, safe_z);
@@ -94,27 +117,27 @@ inline lamina::SheetToolpath make_toolpath(const std::vector<ContourSpec>& specs
   for (std::size_t ci = 0; ci < specs.size(); ++ci) {
     const ContourSpec& s = specs[ci];
     const Station& first = s.stations.front();
-    add(MoveKind::rapid, Eigen::Vector3d(first.tip.x(), first.tip.y(), safe_z), first.axis, 0, false, -1);
-    add(MoveKind::rapid, first.tip, first.axis, 0, false, -1);
+    const int contour = static_cast<int>(ci);
     lamina::ToolContour tc;
     tc.part = s.part;
-    tc.outline = static_cast<int>(ci);
+    tc.outline = contour;
     tc.pass = 0;
     tc.is_hole = s.is_hole;
     tc.closed = true;
     tc.frees = !s.is_hole;
     tc.pierce_mm = first.tip.head<2>();
     tc.first_move = tp.moves.size();
-    const int contour = static_cast<int>(ci);
+    add(MoveKind::rapid, Eigen::Vector3d(first.tip.x(), first.tip.y(), safe_z), first.axis, 0, false, contour);
+    add(MoveKind::rapid, first.tip, first.axis, 0, false, contour);
     add(MoveKind::pierce, first.tip, first.axis, 0, true, contour, 1.25);
     for (std::size_t k = 1; k < s.stations.size(); ++k) {
       const MoveKind kind = k == 1 ? MoveKind::lead_in : k + 1 == s.stations.size() ? MoveKind::lead_out : MoveKind::cut;
       add(kind, s.stations[k].tip, s.stations[k].axis, s.feed_mm_per_s, true, contour);
     }
+    const Station& last = s.stations.back();
+    add(MoveKind::rapid, Eigen::Vector3d(last.tip.x(), last.tip.y(), safe_z), last.axis, 0, false, contour);
     tc.end_move = tp.moves.size();
     tp.contours.push_back(tc);
-    const Station& last = s.stations.back();
-    add(MoveKind::rapid, Eigen::Vector3d(last.tip.x(), last.tip.y(), safe_z), last.axis, 0, false, -1);
   }
   add(MoveKind::rapid, up, Eigen::Vector3d::UnitZ(), 0, false, -1);  // back to park
   return tp;
