@@ -22,6 +22,7 @@ struct PostParams {
   PostDialect dialect = PostDialect::grblhal;
   int linear_decimals = 3;   // mm
   int angular_decimals = 4;  // degrees (4: 1e-4° on a 150 mm pivot is 0.26 µm at the tip)
+  int feed_decimals = 1;     // mm/min (G94); inverse-time F (G93) gets 5 significant digits
   std::string jet_on = "M3";   // M-code(s) that open the cutting-head valve
   std::string jet_off = "M5";
   int program_number = 1000;   // fanuc: O number
@@ -39,7 +40,8 @@ struct PostedProgram {
 };
 
 // Errors name the move (contour, index) that the machine cannot reach: tilt beyond the A limits,
-// a contour whose C travel exceeds a limited C range.
+// a contour whose C travel exceeds a limited C range; and a setup the dialect cannot run (grblhal
+// with head.rtcp: grblHAL has no G43.4). docs/posts.md has the conventions of every dialect.
 std::expected<PostedProgram, Error> post_program(const SheetToolpath& toolpath, const HeadKinematics& head,
                                                  const PostParams& params);
 
