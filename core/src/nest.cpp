@@ -1,0 +1,255 @@
+// Nesting driver: parts grouped by thickness, thin sheets first; within a thickness the stock
+// entries in rack order, each up to its count; the packing itself is nest_matrix.cpp or
+// nest_shape.cpp.
+#include "lamina/core/nest.hpp"
+
+#include "nest_internal.hpp"
+
+#include <fmt/format.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <optional>
+
+namespace lamina {
+
+const char* nest_method_name(NestMethod method) {
+  switch (method) {
+    case NestMethod::matrix: return "matrix";
+    case NestMethod::shape: return "shape";
+  }
+  return "unknown";
+}
+
+Eigen::Vector2d place_point(const Placement& placement, const Eigen::Vector2d& layer_xy) {
+  return detail::rotation_matrix(placement.rotation_rad) * layer_xy + placement.offset_mm;
+}
+
+Polygon2 placed_footprint(const Part& part, const Placement& placement) {
+  Polygon2 out;
+  out.reserve(part.footprint_mm.size());
+  for (const auto& p : part.footprint_mm) out.push_back(place_point(placement, p));
+  return out;
+}
+
+namespace detail {
+
+Eigen::Matrix2d rotation_matrix(double angle_rad) {
+  double c = std::cos(angle_rad);
+  double s = std::sin(angle_rad);
+  const double quarter = angle_rad / (0.5 * std::numbers::pi);
+  const double k = std::round(quarter);
+  if (std::abs(quarter - k) < 1e-12) {
+    const long q = ((static_cast<long>(k) % 4) + 4) % 4;
+    static constexpr double cs[4][2] = {{1, 0}, {0, 1}, {-1, 0}, {0, -1}};
+    c = cs[q][0];
+    s = cs[q][1];
+  }
+  Eigen::Matrix2d r;
+  r << c, -s, s, c;
+  return r;
+}
+
+Bounds rotated_bounds(const Polygon2& ring, double angle_rad) {
+  const Eigen::Matrix2d r = rotation_matrix(angle_rad);
+  Bounds b;
+  bool first = true;
+  for (const auto& p : ring) {
+    const Eigen::Vector2d q = r * p;
+    if (first) {
+      b.min = b.max = q;
+      first = false;
+    } else {
+      b.min = b.min.cwiseMin(q);
+      b.max = b.max.cwiseMax(q);
+    }
+  }
+  return b;
+}
+
+std::vector<double> method_rotations(const NestParams& params) {
+  if (params.method == NestMethod::matrix) return {0.0, 0.5 * std::numbers::pi};
+  return params.rotations_rad;
+}
+
+bool fits_on_sheet(const Part& part, SheetSize size, const NestParams& params) {
+  const double ux = size.length_mm - 2.0 * params.margin_mm;
+  const double uy = size.width_mm - 2.0 * params.margin_mm;
+  constexpr double tol = 1e-9;
+  for (double a : method_rotations(params)) {
+    const Bounds b = rotated_bounds(part.footprint_mm, a);
+    if (b.dx() <= ux + tol && b.dy() <= uy + tol) return true;
+  }
+  return false;
+}
+
+}  // namespace detail
+
+namespace {
+
+constexpr double kSameThicknessMm = 1e-9;  // as stock_thicknesses()
+
+std::string label(const Part& p) { return fmt::format("L{}-{}", p.layer, p.island); }
+
+std::string sheet_size_text(const SheetStock& s) { return fmt::format("{:g} x {:g} mm", s.length_mm, s.width_mm); }
+
+std::optional<Error> check_params(std::span<const Part> parts, const NestParams& params) {
+  auto bad = [](std::string m) { return Error{ErrorCode::invalid_argument, std::move(m)}; };
+  if (!std::isfinite(params.spacing_mm) || params.spacing_mm < 0.0)
+    return bad(fmt::format("nest: spacing must be finite and >= 0 mm (got {:g})", params.spacing_mm));
+  if (!std::isfinite(params.margin_mm) || params.margin_mm < 0.0)
+    return bad(fmt::format("nest: margin must be finite and >= 0 mm (got {:g})", params.margin_mm));
+  if (params.method == NestMethod::shape) {
+    if (params.rotations_rad.empty()) return bad("nest: shape nesting needs at least one rotation");
+    for (double a : params.rotations_rad)
+      if (!std::isfinite(a)) return bad("nest: a rotation is not finite");
+  }
+  for (const Part& p : parts) {
+    if (p.footprint_mm.size() < 3 || !(signed_area_mm2(p.footprint_mm) > 0.0))
+      return bad(fmt::format("nest: part {} has no counter-clockwise footprint ({} points)", label(p),
+                             p.footprint_mm.size()));
+    for (const auto& v : p.footprint_mm)
+      if (!v.allFinite()) return bad(fmt::format("nest: part {} has a footprint point that is not finite", label(p)));
+    if (!std::isfinite(p.thickness_mm) || p.thickness_mm <= 0.0)
+      return bad(fmt::format("nest: part {} has thickness {:g} mm", label(p), p.thickness_mm));
+  }
+  return std::nullopt;
+}
+
+std::vector<detail::PackedSheet> pack(std::span<const Part> parts, std::span<const int> which, detail::SheetSize size,
+                                      const NestParams& params, std::vector<int>& unplaced) {
+  if (which.empty()) return {};
+  if (params.method == NestMethod::shape) return detail::pack_shape(parts, which, size, params, unplaced);
+  return detail::pack_matrix(parts, which, size, params, unplaced);
+}
+
+// The sheets of one thickness (numbered later), or the error naming the thickness.
+std::expected<std::vector<NestedSheet>, Error> nest_thickness(std::span<const Part> parts, std::span<const int> group,
+                                                              double thickness, const Stock& stock,
+                                                              const NestParams& params) {
+  auto bad = [](std::string m) { return std::unexpected(Error{ErrorCode::invalid_argument, std::move(m)}); };
+  std::vector<int> entries;
+  for (int i = 0; i < static_cast<int>(stock.sheets.size()); ++i)
+    if (std::abs(stock.sheets[i].thickness_mm - thickness) <= kSameThicknessMm) entries.push_back(i);
+  if (entries.empty())
+    return bad(fmt::format("nest: no sheet of thickness {:g} mm in stock for {} part(s) (first {})", thickness,
+                           group.size(), label(parts[group.front()])));
+  for (int e : entries) {
+    const SheetStock& s = stock.sheets[e];
+    if (!(s.width_mm > 0.0) || !(s.length_mm > 0.0) || !std::isfinite(s.width_mm) || !std::isfinite(s.length_mm))
+      return bad(fmt::format("nest: the {:g} mm sheet (stock entry {}) has no known size (length {:g}, width {:g} mm); "
+                             "nesting needs width_mm and length_mm",
+                             thickness, e + 1, s.length_mm, s.width_mm));
+    if (s.count < 0) return bad(fmt::format("nest: the {:g} mm sheet (stock entry {}) has count {}", thickness, e + 1, s.count));
+  }
+  auto size_of = [&](int e) { return detail::SheetSize{stock.sheets[e].length_mm, stock.sheets[e].width_mm}; };
+  for (int p : group) {
+    const bool fits = std::any_of(entries.begin(), entries.end(),
+                                  [&](int e) { return detail::fits_on_sheet(parts[p], size_of(e), params); });
+    if (!fits) {
+      const detail::Bounds b = detail::rotated_bounds(parts[p].footprint_mm, 0.0);
+      std::string sizes;
+      for (int e : entries) sizes += (sizes.empty() ? "" : ", ") + sheet_size_text(stock.sheets[e]);
+      return bad(fmt::format("nest: part {} ({:.1f} x {:.1f} mm) is larger than every {:g} mm sheet ({}) less the "
+                             "{:g} mm margin",
+                             label(parts[p]), b.dx(), b.dy(), thickness, sizes, params.margin_mm));
+    }
+  }
+
+  std::vector<NestedSheet> out;
+  std::vector<int> remaining(group.begin(), group.end());
+  int in_stock = 0;
+  int short_by = 0;  // sheets needed beyond the counts
+  std::string short_kind;
+  for (std::size_t k = 0; k < entries.size() && !remaining.empty(); ++k) {
+    const int e = entries[k];
+    const SheetStock& s = stock.sheets[e];
+    const bool last = k + 1 == entries.size();
+    in_stock += s.count;
+    std::vector<int> here;
+    std::vector<int> later;
+    for (int p : remaining) (detail::fits_on_sheet(parts[p], size_of(e), params) ? here : later).push_back(p);
+    std::vector<int> unplaced;
+    std::vector<detail::PackedSheet> sheets = pack(parts, here, size_of(e), params, unplaced);
+    later.insert(later.end(), unplaced.begin(), unplaced.end());
+    const std::size_t take = s.count == 0 ? sheets.size() : std::min<std::size_t>(s.count, sheets.size());
+    for (std::size_t i = 0; i < sheets.size(); ++i) {
+      if (i >= take) {
+        for (const Placement& pl : sheets[i].placements) later.push_back(pl.part);
+        continue;
+      }
+      NestedSheet ns;
+      ns.stock_index = e;
+      ns.thickness_mm = s.thickness_mm;
+      ns.width_mm = s.width_mm;
+      ns.length_mm = s.length_mm;
+      ns.material = s.material;
+      ns.placements = std::move(sheets[i].placements);
+      double area = 0.0;
+      for (const Placement& pl : ns.placements) area += parts[pl.part].area_mm2;
+      ns.utilisation = area / (s.width_mm * s.length_mm);
+      out.push_back(std::move(ns));
+    }
+    if (last && sheets.size() > take) {
+      short_by = static_cast<int>(sheets.size() - take);
+      short_kind = sheet_size_text(s);
+    }
+    std::sort(later.begin(), later.end());
+    remaining = std::move(later);
+  }
+  if (!remaining.empty()) {
+    // Parts left over: those the last kind of sheet would take are counted as `short_by`; any
+    // others only fit an earlier (exhausted) kind.
+    std::string stock_text;
+    for (int e : entries)
+      stock_text += fmt::format("{}{} of {}", stock_text.empty() ? "" : ", ", stock.sheets[e].count,
+                                sheet_size_text(stock.sheets[e]));
+    const std::string needed =
+        short_by > 0 ? fmt::format("at least {} sheets needed ({} more of {})", in_stock + short_by, short_by, short_kind)
+                     : std::string("more sheets of an earlier size needed");
+    return bad(fmt::format("nest: not enough {:g} mm sheets: {} in stock ({}), {} part(s) left over; {}", thickness,
+                           in_stock, stock_text, remaining.size(), needed));
+  }
+  return out;
+}
+
+}  // namespace
+
+std::expected<Nest, Error> nest_parts(std::span<const Part> parts, const Stock& stock, const NestParams& params) {
+  if (auto err = check_params(parts, params)) return std::unexpected(*err);
+  // Thickness groups, ascending (thin sheets are cut first); parts keep input order in a group.
+  std::vector<int> order(parts.size());
+  for (std::size_t i = 0; i < parts.size(); ++i) order[i] = static_cast<int>(i);
+  std::stable_sort(order.begin(), order.end(),
+                   [&](int a, int b) { return parts[a].thickness_mm < parts[b].thickness_mm; });
+  std::vector<std::vector<int>> groups;
+  std::vector<double> thickness;
+  for (int i : order) {
+    if (groups.empty() || parts[i].thickness_mm - thickness.back() > kSameThicknessMm) {
+      groups.emplace_back();
+      thickness.push_back(parts[i].thickness_mm);
+    }
+    groups.back().push_back(i);
+  }
+  std::vector<std::expected<std::vector<NestedSheet>, Error>> results(
+      groups.size(), std::unexpected(Error{ErrorCode::invalid_argument, ""}));
+  auto run = [&](std::size_t g) { results[g] = nest_thickness(parts, groups[g], thickness[g], stock, params); };
+  if (params.parallel && groups.size() > 1) {
+    tbb::parallel_for(std::size_t{0}, groups.size(), run);
+  } else {
+    for (std::size_t g = 0; g < groups.size(); ++g) run(g);
+  }
+  Nest nest;
+  for (auto& r : results) {
+    if (!r) return std::unexpected(r.error());  // the thinnest failing thickness
+    for (NestedSheet& s : *r) {
+      s.index = static_cast<int>(nest.sheets.size()) + 1;
+      nest.sheets.push_back(std::move(s));
+    }
+  }
+  return nest;
+}
+
+}  // namespace lamina
