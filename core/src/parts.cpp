@@ -113,7 +113,8 @@ std::expected<std::vector<Eigen::Vector2d>, Error> place_dowels(const BevelPlan&
           "dowels: no area has material in every layer (layers 0 … {} share none)", plan.layers[i].index)));
   }
   const double r = 0.5 * params.diameter_mm;
-  const ClipperLib::Paths room = offset(common, -(r + params.wall_mm));
+  // 1 µm more: the offset rounds to Clipper's 1 nm grid, and the wall must hold, not nearly hold.
+  const ClipperLib::Paths room = offset(common, -(r + params.wall_mm + 1e-3));
   if (room.empty())
     return std::unexpected(invalid(fmt::format(
         "dowels: no room for a {} mm dowel with a {} mm wall where every layer has material", params.diameter_mm,

@@ -26,7 +26,7 @@ constexpr double s_per_min = 60.0;
 // A feed move whose tip travels less than this is a pure reorientation: its G93 time comes from
 // the arc the pivot travels instead (the tip distance would make it instantaneous).
 constexpr double still_tip_mm = 1e-6;
-constexpr int inverse_time_digits = 5;  // significant digits of a G93 F: 1e-4 relative, far under 0.5 %
+constexpr int inverse_time_digits = 4;  // significant digits of an F word: ≤ 5e-4 relative, a tenth of the 0.5 % checked
 
 enum class Motion : std::uint8_t { none, rapid, feed };
 
@@ -208,7 +208,7 @@ std::expected<PostedProgram, Error> post_program(const SheetToolpath& toolpath, 
       // mm/min of the tip (RTCP: the controller holds the tip's speed; without RTCP the head does
       // not turn, so X Y Z move as the tip). A turn about a still tip keeps the cutting feed.
       const double mm_per_min = tip_distance >= still_tip_mm ? tip_distance / minutes : m.feed_mm_per_s * s_per_min;
-      f = format_number(mm_per_min, params.feed_decimals, kp);
+      f = format_significant(mm_per_min, inverse_time_digits, params.feed_decimals, kp);
       if (inverse_time) {
         line += "G94";
         inverse_time = false;

@@ -1,6 +1,7 @@
 // lamina plan MODEL --out DIR: layers from the stock, the bevel cuts of each layer, the deviation
 // of the same layering cut three ways (vertical, sloped, curved), DIR/stack.stl and DIR/report.json.
 #include "commands.hpp"
+#include "plan_cam.hpp"
 #include "plan_options.hpp"
 #include "plan_report.hpp"
 
@@ -90,10 +91,25 @@ std::string stl_header(const PlanOptions& o, const PlanResult& r) {
   return h;
 }
 
-int run_plan(const PlanOptions& o) {
+// Sheet files of an earlier run that this run will not rewrite must not be mistaken for its own.
+void remove_old_sheet_files(const fs::path& dir) {
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(dir, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (name.starts_with("sheet-") && (name.ends_with(".nc") || name.ends_with(".svg"))) fs::remove(entry.path(), ec);
+  }
+}
+
+int run_plan(const PlanOptions& o, const CamOptions& cam_options) {
   const auto t_start = Clock::now();
   auto settings = resolve_plan_settings(o);
   if (!settings) return report_error(settings.error(), settings.error().code == ErrorCode::invalid_argument ? 2 : 1);
+  std::optional<CamSettings> cam_settings;
+  if (!cam_options.no_programs) {
+    auto c = resolve_cam_settings(cam_options);
+    if (!c) return report_error(c.error(), c.error().code == ErrorCode::invalid_argument ? 2 : 1);
+    cam_settings = std::move(*c);
+  }
   auto dir = prepare_out_dir(o.out_dir);
   if (!dir) return report_error(dir.error());
 
@@ -147,9 +163,30 @@ int run_plan(const PlanOptions& o) {
   if (auto w = write_file_atomically(*dir, "stack.stl", stl); !w)
     return report_error({ErrorCode::io_error, w.error()});
   r.timing.write = seconds_since(t0);
+
+  // Parts, nesting, toolpaths, programs and drawings, one of each per sheet.
+  std::optional<CamResult> cam;
+  remove_old_sheet_files(*dir);
+  if (cam_settings) {
+    const Stock stock = sized_stock(settings->stock, cam_settings->machine, r.warnings);
+    auto c = plan_cam(r.plan, stock, *cam_settings, fs::path(o.model.path).filename().string());
+    if (!c) return report_error(c.error());
+    cam = std::move(*c);
+    r.warnings.insert(r.warnings.end(), cam->warnings.begin(), cam->warnings.end());
+    t0 = Clock::now();
+    for (const SheetOutput& s : cam->sheets) {
+      for (const auto& [name, bytes] : {std::pair{s.program_name, &s.program.text}, std::pair{s.svg_name, &s.svg}})
+        if (auto w = write_file_atomically(*dir, name, *bytes); !w) return report_error({ErrorCode::io_error, w.error()});
+    }
+    r.timing.write += seconds_since(t0);
+  }
   r.timing.total = seconds_since(t_start);
 
-  const nlohmann::ordered_json report = plan_report_json(o, *settings, *model, r);
+  nlohmann::ordered_json report = plan_report_json(o, *settings, *model, r);
+  if (cam) {
+    report["cam"] = cam_json(*cam_settings, *cam);
+    report["sheets"] = sheets_json(*cam);
+  }
   if (auto w = write_file_atomically(*dir, "report.json", report.dump(2) + "\n"); !w)
     return report_error({ErrorCode::io_error, w.error()});
 
@@ -157,8 +194,12 @@ int run_plan(const PlanOptions& o) {
     fmt::print("{}\n", report.dump(2));
   } else {
     print_plan_tables(stdout, report, o.all_rows);
-    fmt::print("wrote {} ({} bytes) and {}\n", (*dir / "stack.stl").string(), stl.size(),
-               (*dir / "report.json").string());
+    fmt::print("\n");
+    print_sheet_table(stdout, report);
+    fmt::print("wrote {} ({} bytes), {}", (*dir / "stack.stl").string(), stl.size(), (*dir / "report.json").string());
+    if (cam && !cam->sheets.empty())
+      fmt::print(", and {} program(s) + drawing(s) {}/sheet-<n>.nc, .svg", cam->sheets.size(), dir->string());
+    fmt::print("\n");
   }
   std::fflush(stdout);  // warnings after the tables they refer to, even when both go to one pipe
   for (const std::string& w : r.warnings) fmt::print(stderr, "warning: {}\n", w);
@@ -169,10 +210,14 @@ int run_plan(const PlanOptions& o) {
 
 void add_plan_command(CLI::App& app, int& exit_code) {
   auto o = std::make_shared<PlanOptions>();
+  auto cam = std::make_shared<CamOptions>();
   CLI::App* cmd = app.add_subcommand(
-      "plan", "Choose layers from the stock, plan the bevel cuts, write DIR/stack.stl and DIR/report.json");
+      "plan",
+      "Choose layers from the stock, plan the bevel cuts, nest the parts on sheets, write DIR/stack.stl, "
+      "DIR/sheet-<n>.nc and .svg, and DIR/report.json");
   add_plan_options(*cmd, *o);
-  cmd->callback([o, &exit_code] { exit_code = run_plan(*o); });
+  add_cam_options(*cmd, *cam);
+  cmd->callback([o, cam, &exit_code] { exit_code = run_plan(*o, *cam); });
 }
 
 }  // namespace lamina::cli

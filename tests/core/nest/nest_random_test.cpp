@@ -4,7 +4,6 @@
 
 #include <gtest/gtest.h>
 
-#include <chrono>
 #include <random>
 
 namespace lamina {
@@ -63,19 +62,19 @@ TEST_P(NestRandom, SeededRandomPolygons) {
   }
 }
 
-TEST_P(NestRandom, TimeFor50And200Parts) {
+// Many parts at once: every placement still valid. (How long it takes is measured in
+// bench/bench_cam, not here.)
+TEST_P(NestRandom, FiftyAndTwoHundredRandomPartsNestValidly) {
   for (int n : {50, 200}) {
     const std::vector<Part> parts = random_parts(n, 2024u, 1.5, 1.5);
     NestParams params;
     params.method = GetParam();
     const Stock stock = one_sheet_kind(1.5, 1250, 625);
-    const auto t0 = std::chrono::steady_clock::now();
     auto nest = nest_parts(parts, stock, params);
-    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     ASSERT_TRUE(nest) << nest.error().message;
     const Summary sum = check_nest(parts, stock, params, *nest);
-    std::printf("[%s] %d random parts on 1250 x 625: %.3f s, %d sheets, mean utilisation %.3f\n",
-                nest_method_name(GetParam()), n, s, sum.sheets, sum.mean_utilisation);
+    std::printf("[%s] %d random parts on 1250 x 625: %d sheets, mean utilisation %.3f\n",
+                nest_method_name(GetParam()), n, sum.sheets, sum.mean_utilisation);
   }
 }
 

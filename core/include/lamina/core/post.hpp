@@ -22,7 +22,7 @@ struct PostParams {
   PostDialect dialect = PostDialect::grblhal;
   int linear_decimals = 3;   // mm
   int angular_decimals = 4;  // degrees (4: 1e-4° on a 150 mm pivot is 0.26 µm at the tip)
-  int feed_decimals = 1;     // mm/min (G94); inverse-time F (G93) gets 5 significant digits
+  int feed_decimals = 1;     // most decimals of a G94 F (mm/min); both F kinds get 4 significant digits
   std::string jet_on = "M3";   // M-code(s) that open the cutting-head valve
   std::string jet_off = "M5";
   int program_number = 1000;   // fanuc: O number
