@@ -21,6 +21,9 @@ inline bool operator!=(const Radians& a, const Radians& b) { return !(a == b); }
 #include <libnest2d/libnest2d.hpp>
 
 #include <algorithm>
+#include <numbers>
+#include <limits>
+#include <Eigen/Core>
 #include <cmath>
 
 namespace lamina::detail {
@@ -63,10 +66,41 @@ Path convex_hull(Path pts) {
   return h;
 }
 
+// Hulls with more corners than this are replaced by a circumscribed polygon: libnest2d's no-fit
+// polygons cost grows with the product of both shapes' corners, and a sliced sphere's 1000-corner
+// rings made 23 parts take 15 s. 64 supporting lines stand at most R·(1/cos(π/64) − 1) = 0.12 % of
+// the radius off a round part: 0.06 mm on Ø100.
+constexpr std::size_t kMaxHullCorners = 64;
+
+// The polygon bounded by the hull's supporting lines in k evenly spaced directions: it contains
+// the hull, and every corner is where two neighbouring supporting lines meet.
+Path circumscribed(const Path& hull, int k) {
+  std::vector<Eigen::Vector2d> u(static_cast<std::size_t>(k));
+  std::vector<double> h(static_cast<std::size_t>(k), -std::numeric_limits<double>::infinity());
+  for (int j = 0; j < k; ++j) {
+    const double a = 2.0 * std::numbers::pi * j / k;
+    u[static_cast<std::size_t>(j)] = {std::cos(a), std::sin(a)};
+    for (const IntPoint& p : hull)
+      h[static_cast<std::size_t>(j)] = std::max(h[static_cast<std::size_t>(j)], u[static_cast<std::size_t>(j)].dot(
+                                                                                   Eigen::Vector2d(static_cast<double>(p.X), static_cast<double>(p.Y))));
+  }
+  Path out;
+  for (int j = 0; j < k; ++j) {
+    const auto& a = u[static_cast<std::size_t>(j)];
+    const auto& b = u[static_cast<std::size_t>((j + 1) % k)];
+    const double ha = h[static_cast<std::size_t>(j)], hb = h[static_cast<std::size_t>((j + 1) % k)];
+    const double det = a.x() * b.y() - a.y() * b.x();
+    const Eigen::Vector2d x((ha * b.y() - hb * a.y()) / det, (a.x() * hb - b.x() * ha) / det);
+    out.emplace_back(static_cast<ClipperLib::cInt>(std::llround(x.x())), static_cast<ClipperLib::cInt>(std::llround(x.y())));
+  }
+  return out;
+}
+
 // The shape libnest2d places for a part: hull offset by `delta_mm` (mitred), clockwise and
 // closed as libnest2d's Clipper backend expects.
 ClipperLib::Polygon item_shape(const Part& part, double delta_mm) {
-  const Path hull = convex_hull(to_clipper(part.footprint_mm));
+  Path hull = convex_hull(to_clipper(part.footprint_mm));
+  if (hull.size() > kMaxHullCorners) hull = circumscribed(hull, static_cast<int>(kMaxHullCorners));
   ClipperLib::Paths grown;
   ClipperLib::ClipperOffset off;
   off.AddPath(hull, ClipperLib::jtMiter, ClipperLib::etClosedPolygon);
