@@ -86,6 +86,9 @@ std::expected<CamSettings, Error> resolve_cam_settings(const CamOptions& o) {
     if (!found) return std::unexpected(usage("--material: " + found.error().message));
     s.material_override = *o.material;
   }
+  if (m.post.dialect == PostDialect::grblhal && m.head.rtcp)
+    return std::unexpected(usage("grblHAL has no RTCP (G43.4): use --rtcp false (pivot coordinates and G93), or "
+                                 "--post fanuc / linuxcnc for a controller that keeps the tool tip"));
   // A pierce in the gap between two parts must not land in the neighbour.
   if (m.nest.spacing_mm < m.cutting.lead_in_mm + m.cutting.kerf_mm)
     return std::unexpected(usage(fmt::format(

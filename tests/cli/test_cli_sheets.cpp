@@ -1,0 +1,133 @@
+// `lamina plan` cut programs as users get them: DIR/sheet-<n>.nc and .svg, report.json's sheets[],
+// the machine file's and the stock's errors.
+#include "cli_runner.hpp"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <string>
+
+namespace {
+
+using namespace lamina_cli_test;
+using nlohmann::json;
+
+const fs::path kConfig = fs::path(LAMINA_EXAMPLES_DIR).parent_path() / "config";
+
+struct TempDir {
+  fs::path path;
+  explicit TempDir(const std::string& name) : path(temp_file(name)) { fs::remove_all(path); }
+  ~TempDir() { fs::remove_all(path); }
+};
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+bool has_text(const CliRun& r, const std::string& s) { return r.out.find(s) != std::string::npos; }
+
+TEST(CliSheets, PlanWritesOneProgramAndOneDrawingPerSheetAndReportsThem) {
+  TempDir out("sheets");
+  fs::create_directories(out.path);
+  // A stale sheet file from an earlier, larger run must disappear.
+  std::ofstream(out.path / "sheet-99.nc") << "G0X0\n";
+  const auto r = lamina("plan " + quoted(kKnob) + " --stock-file " + quoted(kConfig / "stock.toml") +
+                        " --nest matrix --post fanuc --rtcp true --microjoints 2 --out " + quoted(out.path));
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_FALSE(fs::exists(out.path / "sheet-99.nc"));
+  const json j = json::parse(slurp(out.path / "report.json"));
+  ASSERT_TRUE(j.contains("sheets"));
+  ASSERT_TRUE(j.contains("cam"));
+  EXPECT_EQ(j["cam"]["post"], "fanuc");
+  EXPECT_EQ(j["cam"]["nest"], "matrix");
+  std::set<std::pair<int, int>> numbered;
+  double last_t = 0.0;
+  int index = 0;
+  for (const json& s : j["sheets"]) {
+    for (const char* k : {"index", "thickness_mm", "width_mm", "length_mm", "program", "svg", "estimated_time_s",
+                          "utilisation", "parts"})
+      ASSERT_TRUE(s.contains(k)) << k;
+    EXPECT_EQ(s["index"].get<int>(), ++index);
+    EXPECT_GE(s["thickness_mm"].get<double>(), last_t) << "thin sheets before thick";
+    last_t = s["thickness_mm"].get<double>();
+    EXPECT_GT(s["estimated_time_s"].get<double>(), 0.0);
+    EXPECT_GT(s["utilisation"].get<double>(), 0.0);
+    EXPECT_LE(s["utilisation"].get<double>(), 1.0);
+    EXPECT_EQ(s["material"], "aluminium 6061-T6");  // from config/stock.toml
+    const std::string nc = slurp(out.path / s["program"].get<std::string>());
+    const std::string svg = slurp(out.path / s["svg"].get<std::string>());
+    // Fanuc framing and RTCP; the jet's M-codes; contour markers.
+    EXPECT_EQ(nc.rfind("%\n", 0), 0u);
+    EXPECT_NE(nc.find("G43.4"), std::string::npos);
+    EXPECT_NE(nc.find("M30"), std::string::npos);
+    EXPECT_NE(nc.find("(CONTOUR 0 "), std::string::npos);
+    EXPECT_EQ(nc.substr(nc.size() - 2), "%\n");
+    EXPECT_NE(svg.find("<svg"), std::string::npos);
+    for (const json& p : s["parts"]) {
+      for (const char* k : {"layer", "island", "x_mm", "y_mm", "rotation_deg"}) ASSERT_TRUE(p.contains(k)) << k;
+      EXPECT_TRUE(numbered.insert({p["layer"].get<int>(), p["island"].get<int>()}).second) << "part placed twice";
+      EXPECT_NE(svg.find(p["label"].get<std::string>()), std::string::npos) << "label missing from the drawing";
+    }
+  }
+  // Every part of every layer is on a sheet: the knob has one part per layer.
+  EXPECT_EQ(numbered.size(), j["layers"].size());
+  EXPECT_TRUE(has_text(r, "sheet-1.nc") || has_text(r, "sheet-<n>.nc"));
+}
+
+TEST(CliSheets, NotEnoughSheetsIsAClearError) {
+  TempDir out("too-few");
+  const fs::path stock = temp_file("one-sheet.toml");
+  std::ofstream(stock) << "[[sheet]]\nthickness_mm = 2.5\nwidth_mm = 100\nlength_mm = 100\ncount = 1\n"
+                          "material = \"aluminium 6061-T6\"\n";
+  const auto r = lamina("plan " + quoted(kKnob) + " --stock-file " + quoted(stock) + " --out " + quoted(out.path));
+  fs::remove(stock);
+  EXPECT_EQ(r.exit_code, 1) << r.out;
+  EXPECT_TRUE(has_text(r, "2.5")) << r.out;
+  EXPECT_TRUE(has_text(r, "sheet")) << r.out;
+  EXPECT_FALSE(fs::exists(out.path / "report.json"));
+}
+
+TEST(CliSheets, MachineFileErrorsNameTheLineAndKey) {
+  TempDir out("bad-machine");
+  const fs::path machine = temp_file("machine.toml");
+  std::ofstream(machine) << "[head]\npivot_mm = 150\n\n[cutting]\nkerf_mn = 0.9\n";
+  auto r = lamina("plan " + quoted(kKnob) + " --machine " + quoted(machine) + " --out " + quoted(out.path));
+  EXPECT_EQ(r.exit_code, 1) << r.out;
+  EXPECT_TRUE(has_text(r, ":5:")) << r.out;
+  EXPECT_TRUE(has_text(r, "kerf_mn")) << r.out;
+  std::ofstream(machine) << "[post]\ndialect = \"heidenhain\"\n";
+  r = lamina("plan " + quoted(kKnob) + " --machine " + quoted(machine) + " --out " + quoted(out.path));
+  EXPECT_EQ(r.exit_code, 1) << r.out;
+  EXPECT_TRUE(has_text(r, "heidenhain")) << r.out;
+  fs::remove(machine);
+  EXPECT_FALSE(fs::exists(out.path / "report.json"));
+}
+
+TEST(CliSheets, GrblhalWithRtcpAndUnknownMaterialAreRefused) {
+  TempDir out("refused");
+  auto r = lamina("plan " + quoted(kKnob) + " --post grblhal --rtcp true --out " + quoted(out.path));
+  EXPECT_NE(r.exit_code, 0) << r.out;
+  EXPECT_TRUE(has_text(r, "RTCP") || has_text(r, "rtcp") || has_text(r, "G43.4")) << r.out;
+  r = lamina("plan " + quoted(kKnob) + " --material unobtainium --out " + quoted(out.path));
+  EXPECT_EQ(r.exit_code, 2) << r.out;
+  EXPECT_TRUE(has_text(r, "unobtainium")) << r.out;
+  EXPECT_TRUE(has_text(r, "aluminium 6061-T6")) << r.out;  // the known names are listed
+}
+
+TEST(CliSheets, NoProgramsStopsAfterTheStack) {
+  TempDir out("no-programs");
+  const auto r = lamina("plan " + quoted(kKnob) + " --no-programs --out " + quoted(out.path));
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_TRUE(fs::exists(out.path / "stack.stl"));
+  EXPECT_FALSE(fs::exists(out.path / "sheet-1.nc"));
+  const json j = json::parse(slurp(out.path / "report.json"));
+  EXPECT_FALSE(j.contains("sheets"));
+}
+
+}  // namespace
