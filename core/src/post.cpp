@@ -47,7 +47,10 @@ struct Writer {
 };
 
 std::string contour_marker(std::size_t index, const ToolContour& c) {
-  std::string s = fmt::format("CONTOUR {} PART {} OUTLINE {} PASS {}", index, c.part, c.outline, c.pass);
+  // The part as the drawing labels it; an outline of -1 is a dowel hole.
+  const std::string part = c.label.empty() ? fmt::format("PART {}", c.part) : c.label;
+  std::string s = c.outline < 0 ? fmt::format("CONTOUR {} {} DOWEL", index, part)
+                                : fmt::format("CONTOUR {} {} OUTLINE {} PASS {}", index, part, c.outline, c.pass);
   if (c.is_hole) s += " HOLE";
   if (c.frees) s += " FREES";
   if (!c.closed) s += " OPEN";

@@ -342,6 +342,7 @@ class SheetBuilder {
     ToolContour c;
     c.placement = t.placement;
     c.part = t.part;
+    c.label = part_label(parts_[static_cast<std::size_t>(t.part)]);
     c.outline = t.outline;
     c.pass = t.pass;
     c.is_hole = t.is_hole;

@@ -16,6 +16,7 @@
 #include <cstdint>
 #include <expected>
 #include <span>
+#include <string>
 #include <vector>
 
 namespace lamina {
@@ -45,7 +46,8 @@ struct ToolMove {
 struct ToolContour {
   int placement = -1;  // index into NestedSheet::placements
   int part = -1;       // index into the parts span
-  int outline = -1;    // index into LayerPlan::outlines
+  std::string label;   // the part's label, "L3-2" (part_label), for markers an operator reads
+  int outline = -1;    // index into LayerPlan::outlines; -1 for a dowel hole
   int pass = -1;       // index into LayerOutline::passes
   bool is_hole = false;
   bool frees = false;   // part of the pass that separates the outline's inside from its outside
