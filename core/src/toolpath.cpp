@@ -354,7 +354,11 @@ class SheetBuilder {
     const double t_mm = sheet_.thickness_mm;
     const Eigen::Vector3d down = t_mm * Eigen::Vector3d::UnitZ();
 
-    const double lead_in = fit_lead(p_.lead_in_mm, ring, first.tip.head<2>(), first.scrap);
+    // The pierce is vertical: it must clear the part on both faces, so the lead is measured from
+    // whichever end of the first line reaches further into the scrap (a wall that widens
+    // downwards puts the part's bottom edge under a pierce 3 mm off the top contour).
+    const double reach_in = std::max(0.0, (first.bottom.head<2>() - first.tip.head<2>()).dot(first.scrap));
+    const double lead_in = fit_lead(p_.lead_in_mm + reach_in, ring, first.tip.head<2>(), first.scrap);
     const Eigen::Vector2d pierce2 = first.tip.head<2>() + lead_in * first.scrap;
     const Eigen::Vector3d pierce(pierce2.x(), pierce2.y(), 0.0);
     c.pierce_mm = pierce2;

@@ -191,6 +191,19 @@ TEST(Toolpath, KerfOffsetsTheRuledSurfaceAlongItsNormalNotTheTopContour) {
   EXPECT_GT(checked, 150);
 }
 
+TEST(Toolpath, VerticalPiercesClearThePartOnBothFaces) {
+  // A dome-like wall: radius 20 at the bottom, 14 at the top of a 6 mm sheet. A pierce 3 mm off the
+  // top contour would land on the part's bottom edge; it must land 3 mm beyond the bottom one.
+  const double kerf = 0.8;
+  auto f = one_part(make_layer(0, 0.0, 6.0, {circle_outline(20.0, 120, {{20.0, 14.0}}, 0.0, 6.0)}), 0.0, {100, 100}, kerf);
+  auto tp = plan_sheet_toolpath(f.plan, f.parts, f.sheet, aluminium(), params_with_kerf(kerf));
+  ASSERT_TRUE(tp) << tp.error().message;
+  ASSERT_EQ(tp->contours.size(), 1u);
+  const double r = (tp->contours[0].pierce_mm - Eigen::Vector2d(100, 100)).norm();
+  EXPECT_GT(r, 20.0 + 0.5 * kerf + 3.0 - 0.05);
+  EXPECT_LT(r, 20.0 + 0.5 * kerf + 3.0 + 0.5);
+}
+
 TEST(Toolpath, FeedsFollowTheModelAtEachLinesTilt) {
   const Material al = aluminium();
   const ToolpathParams p = params_with_kerf(0.0);
