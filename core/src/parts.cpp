@@ -200,6 +200,19 @@ std::expected<std::vector<Part>, Error> make_parts(const BevelPlan& plan, const 
         return std::unexpected(invalid(fmt::format("layer {} outline {}: the cuts enclose no area", layer.index, oi)));
       part.footprint_mm = detail::from_clipper(*largest);
 
+      // Free room in each hole: inside every ring of the hole on both faces, less half the kerf.
+      for (const int hi : part.holes) {
+        ClipperLib::Paths room;
+        bool first = true;
+        for (ClipperLib::Path& ring : pass_rings(layer.outlines[static_cast<std::size_t>(hi)])) {
+          if (ClipperLib::Area(ring) < 0) ClipperLib::ReversePath(ring);
+          room = first ? ClipperLib::Paths{ring} : boolean(ClipperLib::ctIntersection, room, {ring});
+          first = false;
+        }
+        for (const auto& ring : offset(room, -0.5 * params.kerf_mm))
+          if (ClipperLib::Orientation(ring) && ClipperLib::Area(ring) > 0) part.free_holes_mm.push_back(detail::from_clipper(ring));
+      }
+
       // Material at each face of the freeing pass, holes removed; the larger face counts.
       auto face_area = [&](bool top) {
         auto ring_area = [&](const LayerOutline& o) {

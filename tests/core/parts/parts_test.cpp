@@ -65,6 +65,10 @@ TEST(Parts, OuterWithItsHolesIsOnePartAndIslandsAreNumbered) {
   // Footprint: the square grown by half the kerf with round corners: (40 + 1)² − (4 − π)·0.5².
   EXPECT_GT(signed_area_mm2(a.footprint_mm), 0.0);
   EXPECT_NEAR(signed_area_mm2(a.footprint_mm), 41.0 * 41.0 - (4.0 - std::numbers::pi) * 0.25, 0.01);
+  // The hole's free room: the 10 mm square less half the kerf on every side.
+  ASSERT_EQ(a.free_holes_mm.size(), 1u);
+  EXPECT_NEAR(signed_area_mm2(a.free_holes_mm[0]), 9.0 * 9.0, 1e-6);
+  EXPECT_TRUE(b.free_holes_mm.empty());
 }
 
 TEST(Parts, FootprintReachesTheWidestFaceOfATiltedCut) {

@@ -39,6 +39,10 @@ struct Part {
   // offset by half the kerf — the region the part and its cuts occupy on the sheet.
   Polygon2 footprint_mm;
   double area_mm2 = 0.0;  // material of the part at its larger face (outer minus holes), for utilisation
+  // The scrap inside its holes that no cut of the hole reaches on either face (every pass's top
+  // and bottom ring of the hole intersected, less half the kerf), CCW rings in the layer's XY:
+  // where nesting may put smaller parts. Empty rings are dropped.
+  std::vector<Polygon2> free_holes_mm;
   std::vector<Eigen::Vector2d> dowels_mm;  // centres of its dowel holes (layer XY), cut as vertical holes
 };
 
