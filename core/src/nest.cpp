@@ -1,6 +1,7 @@
-// Nesting driver: parts grouped by thickness, thin sheets first; within a thickness the stock
-// entries in rack order, each up to its count; the packing itself is nest_matrix.cpp or
-// nest_shape.cpp.
+// Nesting driver: parts grouped by thickness, thin sheets first; within a thickness smaller parts
+// first go into the free holes of larger ones (nest_holes.cpp), then the stock entries in rack
+// order, each up to its count, take the rest; the packing itself is nest_matrix.cpp or
+// nest_shape.cpp. A host carries its children onto whatever sheet it lands on.
 #include "lamina/core/nest.hpp"
 
 #include "nest_internal.hpp"
@@ -11,7 +12,9 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <functional>
 #include <optional>
+#include <unordered_map>
 
 namespace lamina {
 
@@ -112,6 +115,12 @@ std::optional<Error> check_params(std::span<const Part> parts, const NestParams&
                              p.footprint_mm.size()));
     for (const auto& v : p.footprint_mm)
       if (!v.allFinite()) return bad(fmt::format("nest: part {} has a footprint point that is not finite", label(p)));
+    if (params.fill_holes)
+      for (const Polygon2& h : p.free_holes_mm) {
+        const bool finite = std::all_of(h.begin(), h.end(), [](const Eigen::Vector2d& v) { return v.allFinite(); });
+        if (h.size() < 3 || !finite || !(signed_area_mm2(h) > 0.0))
+          return bad(fmt::format("nest: part {} has a free hole that is not a finite counter-clockwise ring", label(p)));
+      }
     if (!std::isfinite(p.thickness_mm) || p.thickness_mm <= 0.0)
       return bad(fmt::format("nest: part {} has thickness {:g} mm", label(p), p.thickness_mm));
   }
@@ -158,8 +167,37 @@ std::expected<std::vector<NestedSheet>, Error> nest_thickness(std::span<const Pa
     }
   }
 
+  // Children in holes travel with their hosts: only the rest is packed.
+  detail::HoleFilling filling;
+  if (params.fill_holes) {
+    filling = detail::fill_holes(parts, group, params);
+  } else {
+    filling.free.assign(group.begin(), group.end());
+  }
+  std::unordered_map<int, std::vector<const detail::HostedPart*>> children;
+  for (const detail::HostedPart& h : filling.hosted) children[h.host].push_back(&h);
+  // A packed placement with its children (composed, recursively) before it; each child's `host`
+  // is the index of the placement whose hole holds it.
+  std::function<void(const Placement&, std::vector<Placement>&)> emit = [&](const Placement& pl,
+                                                                            std::vector<Placement>& list) {
+    std::vector<std::size_t> direct;
+    if (auto it = children.find(pl.part); it != children.end())
+      for (const detail::HostedPart* h : it->second) {
+        emit(detail::compose(pl, h->in_host), list);
+        direct.push_back(list.size() - 1);
+      }
+    list.push_back(pl);
+    for (std::size_t i : direct) list[i].host = static_cast<int>(list.size() - 1);
+  };
+  std::function<int(int)> carried = [&](int part) {
+    int n = 1;
+    if (auto it = children.find(part); it != children.end())
+      for (const detail::HostedPart* h : it->second) n += carried(h->in_host.part);
+    return n;
+  };
+
   std::vector<NestedSheet> out;
-  std::vector<int> remaining(group.begin(), group.end());
+  std::vector<int> remaining = filling.free;
   int in_stock = 0;
   int short_by = 0;  // sheets needed beyond the counts
   std::string short_kind;
@@ -186,7 +224,7 @@ std::expected<std::vector<NestedSheet>, Error> nest_thickness(std::span<const Pa
       ns.width_mm = s.width_mm;
       ns.length_mm = s.length_mm;
       ns.material = s.material;
-      ns.placements = std::move(sheets[i].placements);
+      for (const Placement& pl : sheets[i].placements) emit(pl, ns.placements);
       double area = 0.0;
       for (const Placement& pl : ns.placements) area += parts[pl.part].area_mm2;
       ns.utilisation = area / (s.width_mm * s.length_mm);
@@ -209,8 +247,10 @@ std::expected<std::vector<NestedSheet>, Error> nest_thickness(std::span<const Pa
     const std::string needed =
         short_by > 0 ? fmt::format("at least {} sheets needed ({} more of {})", in_stock + short_by, short_by, short_kind)
                      : std::string("more sheets of an earlier size needed");
+    int left = 0;
+    for (int p : remaining) left += carried(p);
     return bad(fmt::format("nest: not enough {:g} mm sheets: {} in stock ({}), {} part(s) left over; {}", thickness,
-                           in_stock, stock_text, remaining.size(), needed));
+                           in_stock, stock_text, left, needed));
   }
   return out;
 }

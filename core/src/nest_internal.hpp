@@ -59,4 +59,25 @@ std::vector<PackedSheet> pack_shape(std::span<const Part> parts, std::span<const
                                     const NestParams& params, std::vector<int>& unplaced,
                                     ShapePackDiagnostics* diagnostics = nullptr);
 
+// Hole filling (nest_holes.cpp), before packing: smaller parts of a thickness group go inside the
+// free holes (Part::free_holes_mm) of larger ones, and travel with them onto whatever sheet the
+// packer gives the host.
+struct HostedPart {
+  int host = -1;       // part index of the part in whose free hole it lies
+  Placement in_host;   // in the host's layer XY: host_xy = R(rotation) · layer_xy + offset
+};
+struct HoleFilling {
+  std::vector<HostedPart> hosted;  // in the order they were put in (hosts by decreasing area)
+  std::vector<int> free;           // the group's parts in no hole, in group order: what gets packed
+  int rejected_by_check = 0;       // positions the final check on real footprints refused (0 expected)
+};
+// Hosts by decreasing footprint area; each free hole by decreasing area; candidates by decreasing
+// footprint area, at every rotation of the method, bottom-left in the hole's inner-fit region
+// less the no-fit regions of the children already there. A hosted part may host in turn.
+HoleFilling fill_holes(std::span<const Part> parts, std::span<const int> group, const NestParams& params);
+
+// The child's sheet placement when its host is placed by `host`:
+// R_h·(R_c·p + t_c) + t_h, i.e. rotation_h + rotation_c (in [0, 2π)) and offset R_h·t_c + t_h.
+Placement compose(const Placement& host, const Placement& child_in_host);
+
 }  // namespace lamina::detail

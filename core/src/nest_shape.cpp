@@ -6,6 +6,7 @@
 // overlaps). So each part goes in as the convex hull of its footprint — what Cura does with its
 // models' hulls — inflated by half the spacing; parts never interlock concavities or sit in holes.
 #include "clipper_bridge.hpp"
+#include "nest_fit.hpp"
 #include "nest_internal.hpp"
 
 #include <libnest2d/common.hpp>
@@ -41,60 +42,11 @@ constexpr double kSlackMm = 1e-5;
 using Path = ClipperLib::Path;
 using IntPoint = ClipperLib::IntPoint;
 
-// Andrew's monotone chain; counter-clockwise (y up), no repeated point.
-Path convex_hull(Path pts) {
-  std::sort(pts.begin(), pts.end(), [](const IntPoint& a, const IntPoint& b) {
-    return a.X != b.X ? a.X < b.X : a.Y < b.Y;
-  });
-  pts.erase(std::unique(pts.begin(), pts.end()), pts.end());
-  if (pts.size() < 3) return pts;
-  auto cross = [](const IntPoint& o, const IntPoint& a, const IntPoint& b) {
-    return static_cast<double>(a.X - o.X) * static_cast<double>(b.Y - o.Y) -
-           static_cast<double>(a.Y - o.Y) * static_cast<double>(b.X - o.X);
-  };
-  Path h(2 * pts.size());
-  std::size_t k = 0;
-  for (std::size_t i = 0; i < pts.size(); ++i) {
-    while (k >= 2 && cross(h[k - 2], h[k - 1], pts[i]) <= 0) --k;
-    h[k++] = pts[i];
-  }
-  for (std::size_t i = pts.size() - 1, t = k + 1; i-- > 0;) {
-    while (k >= t && cross(h[k - 2], h[k - 1], pts[i]) <= 0) --k;
-    h[k++] = pts[i];
-  }
-  h.resize(k - 1);
-  return h;
-}
-
 // Hulls with more corners than this are replaced by a circumscribed polygon: libnest2d's no-fit
 // polygons cost grows with the product of both shapes' corners, and a sliced sphere's 1000-corner
 // rings made 23 parts take 15 s. 64 supporting lines stand at most R·(1/cos(π/64) − 1) = 0.12 % of
 // the radius off a round part: 0.06 mm on Ø100.
 constexpr std::size_t kMaxHullCorners = 64;
-
-// The polygon bounded by the hull's supporting lines in k evenly spaced directions: it contains
-// the hull, and every corner is where two neighbouring supporting lines meet.
-Path circumscribed(const Path& hull, int k) {
-  std::vector<Eigen::Vector2d> u(static_cast<std::size_t>(k));
-  std::vector<double> h(static_cast<std::size_t>(k), -std::numeric_limits<double>::infinity());
-  for (int j = 0; j < k; ++j) {
-    const double a = 2.0 * std::numbers::pi * j / k;
-    u[static_cast<std::size_t>(j)] = {std::cos(a), std::sin(a)};
-    for (const IntPoint& p : hull)
-      h[static_cast<std::size_t>(j)] = std::max(h[static_cast<std::size_t>(j)], u[static_cast<std::size_t>(j)].dot(
-                                                                                   Eigen::Vector2d(static_cast<double>(p.X), static_cast<double>(p.Y))));
-  }
-  Path out;
-  for (int j = 0; j < k; ++j) {
-    const auto& a = u[static_cast<std::size_t>(j)];
-    const auto& b = u[static_cast<std::size_t>((j + 1) % k)];
-    const double ha = h[static_cast<std::size_t>(j)], hb = h[static_cast<std::size_t>((j + 1) % k)];
-    const double det = a.x() * b.y() - a.y() * b.x();
-    const Eigen::Vector2d x((ha * b.y() - hb * a.y()) / det, (a.x() * hb - b.x() * ha) / det);
-    out.emplace_back(static_cast<ClipperLib::cInt>(std::llround(x.x())), static_cast<ClipperLib::cInt>(std::llround(x.y())));
-  }
-  return out;
-}
 
 // The shape libnest2d places for a part: hull offset by `delta_mm` (mitred), clockwise and
 // closed as libnest2d's Clipper backend expects.

@@ -28,12 +28,19 @@ struct NestParams {
   // Rotations tried by shape nesting, degrees at the edge, radians here. Matrix nesting uses 0 or 90°.
   std::vector<double> rotations_rad{0.0, 1.5707963267948966, 3.141592653589793, 4.71238898038469};
   bool parallel = true;
+  // Put smaller parts inside the free holes (Part::free_holes_mm) of larger ones before packing,
+  // at least spacing_mm from the hole's free ring and from each other (docs/nesting.md).
+  bool fill_holes = true;
 };
 
 struct Placement {
   int part = -1;              // index into the parts span given to nest_parts
   double rotation_rad = 0.0;  // about +Z, applied before offset_mm
   Eigen::Vector2d offset_mm = Eigen::Vector2d::Zero();
+  // Index in the sheet's placements of the part in whose free hole this one lies (-1: none).
+  // The host's hole cut frees the slug this part sits on, so this part must be cut completely
+  // before any cut of its host.
+  int host = -1;
 };
 
 struct NestedSheet {
@@ -43,8 +50,11 @@ struct NestedSheet {
   double width_mm = 0.0;     // sheet y extent
   double length_mm = 0.0;    // sheet x extent
   std::string material;
-  std::vector<Placement> placements;  // in the order the parts are numbered on the sheet
-  double utilisation = 0.0;  // part area / sheet area
+  // In the order the parts are numbered on the sheet. A part inside another's hole comes before
+  // its host (children first, then the host, recursively), and the cutting order must keep that:
+  // a placement is cut completely before placements[host] (Placement::host).
+  std::vector<Placement> placements;
+  double utilisation = 0.0;  // area of all its parts (those in holes too) / sheet area
 };
 
 struct Nest {

@@ -1,0 +1,191 @@
+// No-fit and inner-fit regions with Clipper 6 (see nest_fit.hpp for why each formula is exact).
+#include "nest_fit.hpp"
+
+#include <Eigen/Core>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+namespace lamina::detail {
+
+using ClipperLib::IntPoint;
+using ClipperLib::Path;
+using ClipperLib::Paths;
+
+namespace {
+
+// Exact for any nm coordinates Clipper accepts (products need up to 2 × 62 bits).
+__int128 cross(const IntPoint& o, const IntPoint& a, const IntPoint& b) {
+  return static_cast<__int128>(a.X - o.X) * (b.Y - o.Y) - static_cast<__int128>(a.Y - o.Y) * (b.X - o.X);
+}
+
+constexpr std::size_t kProxyCorners = 64;
+
+}  // namespace
+
+Path convex_hull(Path pts) {
+  std::sort(pts.begin(), pts.end(), [](const IntPoint& a, const IntPoint& b) {
+    return a.X != b.X ? a.X < b.X : a.Y < b.Y;
+  });
+  pts.erase(std::unique(pts.begin(), pts.end()), pts.end());
+  if (pts.size() < 3) return pts;
+  Path h(2 * pts.size());
+  std::size_t k = 0;
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    while (k >= 2 && cross(h[k - 2], h[k - 1], pts[i]) <= 0) --k;
+    h[k++] = pts[i];
+  }
+  for (std::size_t i = pts.size() - 1, t = k + 1; i-- > 0;) {
+    while (k >= t && cross(h[k - 2], h[k - 1], pts[i]) <= 0) --k;
+    h[k++] = pts[i];
+  }
+  h.resize(k - 1);
+  return h;
+}
+
+Path circumscribed(const Path& hull, int k) {
+  std::vector<Eigen::Vector2d> u(static_cast<std::size_t>(k));
+  std::vector<double> h(static_cast<std::size_t>(k), -std::numeric_limits<double>::infinity());
+  for (std::size_t j = 0; j < u.size(); ++j) {
+    const double a = 2.0 * std::numbers::pi * static_cast<double>(j) / k;
+    u[j] = {std::cos(a), std::sin(a)};
+    for (const IntPoint& p : hull)
+      h[j] = std::max(h[j], u[j].dot(Eigen::Vector2d(static_cast<double>(p.X), static_cast<double>(p.Y))));
+  }
+  Path out;
+  for (std::size_t j = 0; j < u.size(); ++j) {
+    const std::size_t n = (j + 1) % u.size();
+    const Eigen::Vector2d& a = u[j];
+    const Eigen::Vector2d& b = u[n];
+    const double det = a.x() * b.y() - a.y() * b.x();
+    const Eigen::Vector2d x((h[j] * b.y() - h[n] * a.y()) / det, (a.x() * h[n] - b.x() * h[j]) / det);
+    out.emplace_back(static_cast<ClipperLib::cInt>(std::llround(x.x())), static_cast<ClipperLib::cInt>(std::llround(x.y())));
+  }
+  return out;
+}
+
+bool is_convex(const Path& ring) {
+  const std::size_t n = ring.size();
+  if (n < 3) return false;
+  for (std::size_t i = 0; i < n; ++i)
+    if (cross(ring[i], ring[(i + 1) % n], ring[(i + 2) % n]) < 0) return false;
+  return true;
+}
+
+Path outer_proxy(const Path& ring) {
+  Path hull = convex_hull(ring);
+  if (hull.size() < 3 || ClipperLib::Area(hull) > 1.02 * std::abs(ClipperLib::Area(ring))) return ring;
+  return hull.size() > kProxyCorners ? circumscribed(hull, static_cast<int>(kProxyCorners)) : hull;
+}
+
+Path inner_proxy(const Path& ring) {
+  if (ring.size() <= kProxyCorners || !is_convex(ring)) return ring;
+  Path out;
+  for (std::size_t i = 0; i < kProxyCorners; ++i) out.push_back(ring[i * ring.size() / kProxyCorners]);
+  return out;
+}
+
+Path translated(const Path& ring, IntPoint by) {
+  Path out;
+  out.reserve(ring.size());
+  for (const IntPoint& p : ring) out.emplace_back(p.X + by.X, p.Y + by.Y);
+  return out;
+}
+
+Path negated(const Path& ring) {
+  Path out;
+  out.reserve(ring.size());
+  for (const IntPoint& p : ring) out.emplace_back(-p.X, -p.Y);
+  return out;  // a point reflection keeps the turning sense
+}
+
+Paths boolean(ClipperLib::ClipType op, const Paths& subject, const Paths& clip) {
+  ClipperLib::Clipper c;
+  c.AddPaths(subject, ClipperLib::ptSubject, true);
+  c.AddPaths(clip, ClipperLib::ptClip, true);
+  Paths out;
+  c.Execute(op, out, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
+  return out;
+}
+
+Paths offset_mitre(const Paths& paths, double delta_mm) {
+  ClipperLib::ClipperOffset off;  // MiterLimit 2: squared beyond, the square's edge at |delta|
+  off.AddPaths(paths, ClipperLib::jtMiter, ClipperLib::etClosedPolygon);
+  Paths out;
+  off.Execute(out, delta_mm * kClipperUnitsPerMm);
+  return out;
+}
+
+Paths minkowski_sum(const Path& a, const Path& b) {
+  if (a.empty() || b.empty()) return {};
+  if (is_convex(a) && is_convex(b)) {
+    Path sums;
+    sums.reserve(a.size() * b.size());
+    for (const IntPoint& p : a)
+      for (const IntPoint& q : b) sums.emplace_back(p.X + q.X, p.Y + q.Y);
+    Path hull = convex_hull(std::move(sums));
+    return hull.size() >= 3 ? Paths{hull} : Paths{};
+  }
+  Paths quads;
+  ClipperLib::MinkowskiSum(b, a, quads, true);
+  return boolean(ClipperLib::ctUnion, quads, {translated(a, b.front()), translated(b, a.front())});
+}
+
+Paths inner_fit_general(const Paths& room, const Path& c) {
+  if (c.empty()) return {};
+  const Path neg = negated(c);
+  const IntPoint minus_c0{-c.front().X, -c.front().Y};
+  ClipperLib::Clipper clip;
+  for (const Path& r : room) {
+    if (r.size() < 3) continue;
+    clip.AddPath(translated(r, minus_c0), ClipperLib::ptSubject, true);
+    Paths band;
+    ClipperLib::MinkowskiSum(neg, r, band, true);
+    clip.AddPaths(band, ClipperLib::ptClip, true);
+    clip.AddPath(translated(neg, r.front()), ClipperLib::ptClip, true);
+  }
+  Paths out;
+  clip.Execute(ClipperLib::ctDifference, out, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
+  return out;
+}
+
+Paths inner_fit(const Paths& room, const Path& c) {
+  if (room.size() != 1 || !is_convex(room.front()) || !is_convex(c)) return inner_fit_general(room, c);
+  // C + t lies left of room edge (p, p + e) iff its corner c* of least e × c does: the edge moved by −c*.
+  const Path& r = room.front();
+  using V = Eigen::Vector2d;
+  auto v = [](const IntPoint& p) { return V(static_cast<double>(p.X), static_cast<double>(p.Y)); };
+  auto cr = [](const V& a, const V& b) { return a.x() * b.y() - a.y() * b.x(); };
+  std::vector<V> poly;
+  for (const IntPoint& p : r) poly.push_back(v(p) - v(c.front()));
+  for (std::size_t i = 0; i < r.size() && !poly.empty(); ++i) {
+    const V e = v(r[(i + 1) % r.size()]) - v(r[i]);
+    if (e.squaredNorm() == 0.0) continue;
+    const IntPoint* best = &c.front();
+    for (const IntPoint& q : c)
+      if (cr(e, v(q)) < cr(e, v(*best))) best = &q;
+    const V q0 = v(r[i]) - v(*best);
+    std::vector<V> next;  // Sutherland–Hodgman against one line
+    for (std::size_t k = 0; k < poly.size(); ++k) {
+      const V& a = poly[k];
+      const V& b = poly[(k + 1) % poly.size()];
+      const double da = cr(e, a - q0);
+      const double db = cr(e, b - q0);
+      if (da >= 0.0) next.push_back(a);
+      if ((da >= 0.0) != (db >= 0.0)) next.push_back(a + (b - a) * (da / (da - db)));
+    }
+    poly = std::move(next);
+  }
+  Path out;
+  for (const V& p : poly) {
+    const IntPoint q{static_cast<ClipperLib::cInt>(std::llround(p.x())), static_cast<ClipperLib::cInt>(std::llround(p.y()))};
+    if (out.empty() || !(out.back() == q)) out.push_back(q);
+  }
+  while (out.size() > 1 && out.back() == out.front()) out.pop_back();
+  if (out.size() < 3 || ClipperLib::Area(out) <= 0.0) return {};
+  return {out};
+}
+
+}  // namespace lamina::detail
