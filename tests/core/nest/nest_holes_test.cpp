@@ -174,7 +174,7 @@ TEST_P(NestHoles, SmallPartsGoInsideTheBigRing) {
               nest_method_name(GetParam()), a.sheets, a.mean_utilisation, b.sheets, b.mean_utilisation);
 }
 
-// A sheet rotated host: the children follow it (the packer may turn the ring by 90°).
+// Four rings with L-shapes: the children follow their hosts onto both sheets (the packer may turn a ring).
 TEST_P(NestHoles, ChildrenFollowTheirHostOntoEverySheet) {
   std::vector<Part> parts;
   for (int k = 0; k < 4; ++k) {
