@@ -7,6 +7,7 @@
 #include "../../../core/src/nest_fit.hpp"
 #include "../../../core/src/nest_internal.hpp"
 
+#include <gtest/gtest-spi.h>
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -117,6 +118,52 @@ TEST(NestHoles, ComposedPlacementIsHostAfterChild) {
     EXPECT_LT((place_point(sheet, p) - want).norm(), 1e-12);
   }
   EXPECT_EQ(sheet.part, 1);
+}
+
+// The failures check_nest reports for a nest, intercepted (not failing this test).
+std::vector<std::string> checker_failures(std::span<const Part> parts, const Stock& stock, const NestParams& params,
+                                          const Nest& nest) {
+  ::testing::TestPartResultArray results;
+  {
+    ::testing::ScopedFakeTestPartResultReporter reporter(
+        ::testing::ScopedFakeTestPartResultReporter::INTERCEPT_ONLY_CURRENT_THREAD, &results);
+    check_nest(parts, stock, params, nest);
+  }
+  std::vector<std::string> out;
+  for (int i = 0; i < results.size(); ++i) out.emplace_back(results.GetTestPartResult(i).message());
+  return out;
+}
+
+bool any_contains(const std::vector<std::string>& messages, const std::string& what) {
+  return std::any_of(messages.begin(), messages.end(), [&](const std::string& m) { return m.find(what) != std::string::npos; });
+}
+
+// The checker itself: a child too close to the hole's ring, or listed after its host, fails.
+TEST(NestHoles, CheckNestRefusesBadChildren) {
+  const std::vector<Part> parts{ring_part(100, 90, 1), make_part(rect(30, 30), 3.0, 2, 1)};
+  const Stock stock = one_sheet_kind(3.0, 230, 230);
+  const NestParams params = with(NestMethod::matrix);
+  auto sheet_with = [&](Eigen::Vector2d child_at, bool child_first) {
+    Nest n;
+    NestedSheet s;
+    s.index = 1;
+    s.stock_index = 0;
+    s.thickness_mm = 3.0;
+    s.width_mm = s.length_mm = 230;
+    s.material = "aluminium";
+    const Placement host{0, 0.0, {115, 115}};
+    const Placement child{1, 0.0, child_at, child_first ? 1 : -1};
+    s.placements = child_first ? std::vector<Placement>{child, host} : std::vector<Placement>{host, child};
+    s.utilisation = (parts[0].area_mm2 + parts[1].area_mm2) / (230.0 * 230.0);
+    n.sheets.push_back(s);
+    return n;
+  };
+  const Summary ok = check_nest(parts, stock, params, sheet_with({100, 100}, true));
+  EXPECT_EQ(ok.nested_pairs, 1);
+  // The square's right edge 88 mm from the centre: 2 mm from the Ø180 free ring.
+  EXPECT_TRUE(any_contains(checker_failures(parts, stock, params, sheet_with({115 + 58, 100}, true)),
+                           "closer than the spacing"));
+  EXPECT_TRUE(any_contains(checker_failures(parts, stock, params, sheet_with({100, 100}, false)), "comes after it"));
 }
 
 // A Ø200 ring with a Ø180 free hole and small parts: they all go in, each at least the spacing
