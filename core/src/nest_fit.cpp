@@ -80,10 +80,52 @@ Path outer_proxy(const Path& ring) {
   return hull.size() > kProxyCorners ? circumscribed(hull, static_cast<int>(kProxyCorners)) : hull;
 }
 
+namespace {
+
+// How far the ring's corners lie inside its convex hull at most: every pocket of the ring lies
+// under one hull edge, within the strip its corners span, so the hull eroded by this lies inside
+// the ring. (Faceted round holes come out of the slicer and Clipper a few nm off convex.)
+double pocket_depth(const Path& ring, const Path& hull) {
+  double depth = 0.0;
+  for (const IntPoint& p : ring) {
+    double nearest = std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < hull.size(); ++i) {
+      const IntPoint& a = hull[i];
+      const IntPoint& b = hull[(i + 1) % hull.size()];
+      const double ex = static_cast<double>(b.X - a.X), ey = static_cast<double>(b.Y - a.Y);
+      const double len = std::hypot(ex, ey);
+      if (len == 0.0) continue;
+      // Inside the CCW hull the cross product is ≥ 0: the distance to the edge's line.
+      nearest = std::min(nearest, (ex * static_cast<double>(p.Y - a.Y) - ey * static_cast<double>(p.X - a.X)) / len);
+    }
+    depth = std::max(depth, nearest);
+  }
+  return depth;
+}
+
+}  // namespace
+
 Path inner_proxy(const Path& ring) {
-  if (ring.size() <= kProxyCorners || !is_convex(ring)) return ring;
+  if (ring.size() <= kProxyCorners) return ring;
+  Path convex = ring;
+  if (!is_convex(ring)) {
+    // Nearly convex (pockets under 0.1 % of the hull's size): the hull eroded by the deepest pocket.
+    const Path hull = convex_hull(ring);
+    if (hull.size() < 3) return ring;
+    const double depth = pocket_depth(ring, hull);
+    const double size = std::sqrt(std::abs(ClipperLib::Area(hull)));
+    if (depth > 1e-3 * size) return ring;
+    ClipperLib::ClipperOffset off;
+    off.AddPath(hull, ClipperLib::jtMiter, ClipperLib::etClosedPolygon);
+    Paths eroded;
+    off.Execute(eroded, -(depth + 2.0));  // + 2 nm: the offset's own rounding
+    if (eroded.size() != 1 || !ClipperLib::Orientation(eroded.front())) return ring;
+    convex = std::move(eroded.front());
+    if (convex.size() <= kProxyCorners) return convex;
+  }
+  // Corners of a convex ring evenly picked: their hull lies in any convex set holding them.
   Path out;
-  for (std::size_t i = 0; i < kProxyCorners; ++i) out.push_back(ring[i * ring.size() / kProxyCorners]);
+  for (std::size_t i = 0; i < kProxyCorners; ++i) out.push_back(convex[i * convex.size() / kProxyCorners]);
   return out;
 }
 

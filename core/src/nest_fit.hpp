@@ -23,7 +23,9 @@ bool is_convex(const ClipperLib::Path& ring);
 ClipperLib::Path outer_proxy(const ClipperLib::Path& ring);
 
 // A ring contained in `ring`: for a convex ring of more than 64 corners, 64 of its corners evenly
-// picked (their hull lies in any convex set holding them), else the ring itself.
+// picked (their hull lies in any convex set holding them); for a nearly convex one (pockets no
+// deeper than 0.1 % of its size), the same from its hull eroded by the deepest pocket; else the
+// ring itself.
 ClipperLib::Path inner_proxy(const ClipperLib::Path& ring);
 
 // A ⊕ B = {a + b} for two simple rings: exactly the hull of the corner sums when both are convex;

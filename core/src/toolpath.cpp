@@ -79,7 +79,9 @@ class SheetBuilder {
     out_.sheet = sheet_.index;
     out_.thickness_mm = sheet_.thickness_mm;
     rapid_to({p_.park_mm.x(), p_.park_mm.y(), p_.safe_z_mm}, Eigen::Vector3d::UnitZ(), -1);
-    for (const int pi : cutting_order()) {
+    auto order = cutting_order();
+    if (!order) return std::unexpected(order.error());
+    for (const int pi : *order) {
       if (auto ok = cut_placement(pi); !ok) return std::unexpected(ok.error());
     }
     rapid_to({p_.park_mm.x(), p_.park_mm.y(), p_.safe_z_mm}, Eigen::Vector3d::UnitZ(), -1);
@@ -88,10 +90,21 @@ class SheetBuilder {
   }
 
  private:
-  // Placements by nearest neighbour from the park position (footprint centroids).
-  std::vector<int> cutting_order() const {
+  // Placements by nearest neighbour from the park position (footprint centroids), except that a
+  // part nested in another part's hole (Placement::host) is cut completely before its host: the
+  // host's hole cut frees the slug the child sits on.
+  std::expected<std::vector<int>, Error> cutting_order() const {
+    const std::size_t n = sheet_.placements.size();
     std::vector<Eigen::Vector2d> centre;
+    std::vector<int> waiting(n, 0);  // children of each placement not cut yet
     for (const Placement& pl : sheet_.placements) {
+      if (pl.part < 0 || static_cast<std::size_t>(pl.part) >= parts_.size())
+        return std::unexpected(invalid(fmt::format("sheet {}: a placement names part {} of {}", sheet_.index, pl.part,
+                                                   parts_.size())));
+      if (pl.host >= static_cast<int>(n) || pl.host < -1 || pl.host == static_cast<int>(centre.size()))
+        return std::unexpected(invalid(fmt::format("sheet {}: placement {} names host {} of {}", sheet_.index,
+                                                   centre.size(), pl.host, n)));
+      if (pl.host >= 0) ++waiting[static_cast<std::size_t>(pl.host)];
       const Part& part = parts_[static_cast<std::size_t>(pl.part)];
       Eigen::Vector2d c = Eigen::Vector2d::Zero();
       for (const auto& q : part.footprint_mm) c += q;
@@ -99,14 +112,17 @@ class SheetBuilder {
       centre.push_back(place_point(pl, c));
     }
     std::vector<int> order;
-    std::vector<bool> done(centre.size(), false);
+    std::vector<bool> done(n, false);
     Eigen::Vector2d at = p_.park_mm;
-    for (std::size_t k = 0; k < centre.size(); ++k) {
-      std::size_t best = centre.size();
-      for (std::size_t i = 0; i < centre.size(); ++i)
-        if (!done[i] && (best == centre.size() || (centre[i] - at).norm() < (centre[best] - at).norm())) best = i;
+    for (std::size_t k = 0; k < n; ++k) {
+      std::size_t best = n;
+      for (std::size_t i = 0; i < n; ++i)
+        if (!done[i] && waiting[i] == 0 && (best == n || (centre[i] - at).norm() < (centre[best] - at).norm())) best = i;
+      if (best == n)
+        return std::unexpected(invalid(fmt::format("sheet {}: the placements' hosts form a cycle", sheet_.index)));
       done[best] = true;
       order.push_back(static_cast<int>(best));
+      if (const int h = sheet_.placements[best].host; h >= 0) --waiting[static_cast<std::size_t>(h)];
       at = centre[best];
     }
     return order;

@@ -152,6 +152,7 @@ std::map<std::string, Section, std::less<>> sections() {
        })},
       {"spacing_mm", number(0, false, 1000, "mm", 1, [](auto& c, double v) { c.nest.spacing_mm = v; })},
       {"margin_mm", number(0, false, 1000, "mm", 1, [](auto& c, double v) { c.nest.margin_mm = v; })},
+      {"fill_holes", flag([](auto& c, bool v) { c.nest.fill_holes = v; })},
       {"sheet_width_mm", number(0, true, 1e5, "mm", 1, [](auto& c, double v) { c.sheet_width_mm = v; })},
       {"sheet_length_mm", number(0, true, 1e5, "mm", 1, [](auto& c, double v) { c.sheet_length_mm = v; })},
   };

@@ -46,6 +46,7 @@ void add_cam_options(CLI::App& cmd, CamOptions& o) {
   cmd.add_option("--microjoint-width", o.microjoint_width_mm, "Uncut width of a microjoint (mm)")->check(CLI::Range(0.01, 50.0));
   cmd.add_option("--dowels", o.dowels, "Registration dowel holes through every layer (0: none)")->check(CLI::Range(0, 64));
   cmd.add_option("--dowel-diameter", o.dowel_diameter_mm, "Dowel hole diameter (mm)")->check(CLI::Range(0.5, 100.0));
+  cmd.add_option("--fill-holes", o.fill_holes, "Nest smaller parts inside the holes of larger ones (true/false)");
   cmd.add_flag("--no-programs", o.no_programs, "Stop after the stack: no nesting, programs or sheet drawings");
 }
 
@@ -72,6 +73,7 @@ std::expected<CamSettings, Error> resolve_cam_settings(const CamOptions& o) {
   if (o.kerf_mm) m.cutting.kerf_mm = *o.kerf_mm;
   if (o.spacing_mm) m.nest.spacing_mm = *o.spacing_mm;
   if (o.margin_mm) m.nest.margin_mm = *o.margin_mm;
+  if (o.fill_holes) m.nest.fill_holes = *o.fill_holes;
   if (o.lead_in_mm) m.cutting.lead_in_mm = *o.lead_in_mm;
   if (o.lead_out_mm) m.cutting.lead_out_mm = *o.lead_out_mm;
   if (o.pierce_dwell_s) m.cutting.pierce_dwell_s = *o.pierce_dwell_s;
@@ -183,6 +185,9 @@ Json sheets_json(const CamResult& r) {
                        {"x_mm", pl.offset_mm.x()},
                        {"y_mm", pl.offset_mm.y()},
                        {"rotation_deg", pl.rotation_rad / kDeg},
+                       {"inside", pl.host >= 0 ? Json(part_label(r.parts[static_cast<std::size_t>(
+                                                     s.sheet.placements[static_cast<std::size_t>(pl.host)].part)]))
+                                               : Json(nullptr)},
                        {"dowels", p.dowels_mm.size()}});
     }
     const CutTime& t = s.toolpath.time;
@@ -219,6 +224,7 @@ Json cam_json(const CamSettings& s, const CamResult& r) {
           {"nest", nest_method_name(m.nest.method)},
           {"spacing_mm", m.nest.spacing_mm},
           {"margin_mm", m.nest.margin_mm},
+          {"fill_holes", m.nest.fill_holes},
           {"post", post_dialect_name(m.post.dialect)},
           {"rtcp", m.head.rtcp},
           {"feed_model", feed_model_name(m.cutting.feed.model)},

@@ -31,7 +31,7 @@ struct CamOptions {
   std::optional<double> kerf_mm, spacing_mm, margin_mm, lead_in_mm, lead_out_mm, pierce_dwell_s, microjoint_width_mm,
       dowel_diameter_mm;
   std::optional<int> dowels, microjoints, quality;
-  std::optional<bool> rtcp;
+  std::optional<bool> rtcp, fill_holes;
   bool no_programs = false;  // stop after the stack (no nesting, programs, drawings)
 };
 

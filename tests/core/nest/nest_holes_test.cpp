@@ -109,6 +109,43 @@ TEST(NestFit, ConvexShortcutEqualsTheGeneralFormula) {
   }
 }
 
+TEST(NestFit, InnerProxyOfANearlyConvexHoleIsInsideItAndSmall) {
+  // A 400-gon hole (R 80) with corners pushed in by up to 20 µm (nearly convex, as faceted holes
+  // come out of slicing and Clipper), and one with a real 5 mm notch.
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> dent(0.0, 0.02);
+  Polygon2 noisy = circle(80, 400);
+  for (auto& p : noisy) p *= 1.0 - dent(rng) / 80.0;
+  const Path ring = to_path(noisy);
+  ASSERT_FALSE(detail::is_convex(ring));
+  const Path proxy = detail::inner_proxy(ring);
+  EXPECT_LE(proxy.size(), 64u);
+  EXPECT_EQ(area_of(clip(ClipperLib::ctDifference, {proxy}, {ring})), 0.0) << "the proxy must lie inside the hole";
+  // It gives up little: a 64-gon in the R 80 circle, less the 20 µm pockets.
+  EXPECT_GT(area_of({proxy}), 0.99 * area_of({ring}));
+
+  // A square hole with 400 corners along its edges, dented in by up to 20 µm: its hull is the
+  // square itself, which the dents cut into — only the erosion keeps the proxy inside.
+  Polygon2 dented;
+  for (int side = 0; side < 4; ++side)
+    for (int k = 0; k < 100; ++k) {
+      const double t = k / 100.0;
+      const Eigen::Vector2d a[4] = {{0, 0}, {100, 0}, {100, 100}, {0, 100}};
+      const Eigen::Vector2d p = a[side] + t * (a[(side + 1) % 4] - a[side]);
+      const Eigen::Vector2d inward = Eigen::Vector2d(50, 50) - p;
+      dented.push_back(k == 0 ? p : Eigen::Vector2d(p + dent(rng) * inward.normalized()));
+    }
+  const Path square_ring = to_path(dented);
+  const Path square_proxy = detail::inner_proxy(square_ring);
+  EXPECT_EQ(area_of(clip(ClipperLib::ctDifference, {square_proxy}, {square_ring})), 0.0);
+  EXPECT_GT(area_of({square_proxy}), 0.999 * 100 * 100);
+
+  Polygon2 notched = circle(80, 400);
+  for (int i = 0; i < 5; ++i) notched[static_cast<std::size_t>(i)] *= 75.0 / 80.0;
+  const Path deep = to_path(notched);
+  EXPECT_EQ(detail::inner_proxy(deep), deep);  // a real pocket: the ring itself
+}
+
 TEST(NestHoles, ComposedPlacementIsHostAfterChild) {
   const Placement host{0, 1.1, {300.0, -20.0}};
   const Placement child{1, 0.7, {12.0, 5.5}};

@@ -352,6 +352,34 @@ TEST(Toolpath, SmallHolesGetAShortLeadAndDowelsAreCutVertical) {
   EXPECT_LT((hole.pierce_mm - Eigen::Vector2d(110, 100)).norm(), 1.6);
 }
 
+TEST(Toolpath, APartNestedInAHoleIsCutBeforeItsHost) {
+  // Layer 0: a ring (Ø100 with a Ø80 hole); layer 1: a Ø30 disc, nested in the ring's hole.
+  Fixture f;
+  f.plan.layers.push_back(make_layer(0, 0.0, 5.0, {circle_outline(50.0, 96, {{50.0, 50.0}}, 0.0, 5.0),
+                                                   circle_outline(40.0, 96, {{40.0, 40.0}}, 0.0, 5.0, true, 0)}));
+  f.plan.layers.push_back(make_layer(1, 5.0, 5.0, {circle_outline(15.0, 48, {{15.0, 15.0}}, 5.0, 10.0)}));
+  f.parts = *make_parts(f.plan, PartParams{});
+  f.sheet.index = 1;
+  f.sheet.thickness_mm = 5.0;
+  f.sheet.width_mm = f.sheet.length_mm = 300;
+  // Listed host first, and the host's pierce nearer the park position: only Placement::host puts
+  // the disc first.
+  f.sheet.placements.push_back({0, 0.0, {100, 100}, -1});
+  f.sheet.placements.push_back({1, 0.0, {110, 100}, 0});
+  auto tp = plan_sheet_toolpath(f.plan, f.parts, f.sheet, aluminium(), ToolpathParams{});
+  ASSERT_TRUE(tp) << tp.error().message;
+  ASSERT_EQ(tp->contours.size(), 3u);
+  EXPECT_EQ(tp->contours[0].placement, 1);  // the disc, whole
+  EXPECT_EQ(tp->contours[1].placement, 0);  // then the ring's hole (freeing the slug the disc sat on)
+  EXPECT_TRUE(tp->contours[1].is_hole);
+  EXPECT_EQ(tp->contours[2].placement, 0);
+
+  f.sheet.placements[0].host = 1;  // each the other's host: no order can work
+  tp = plan_sheet_toolpath(f.plan, f.parts, f.sheet, aluminium(), ToolpathParams{});
+  ASSERT_FALSE(tp);
+  EXPECT_NE(tp.error().message.find("cycle"), std::string::npos) << tp.error().message;
+}
+
 TEST(Toolpath, BadInputsAreNamed) {
   auto f = one_part(dev_test::disc_layer(0, 0.0, 5.0, 20.0, 48), 0.0, {100, 100});
   ToolpathParams p;
