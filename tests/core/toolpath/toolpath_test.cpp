@@ -287,6 +287,43 @@ TEST(Toolpath, TrimRunsComeBeforeTheFreeingPassAndStartOnItsSurface) {
   EXPECT_TRUE(tp->contours[2].frees && tp->contours[2].closed);
 }
 
+TEST(Toolpath, TrimRunsSplitByShortSharedStretchesAreCutAsOne) {
+  // Every other station convex (as on a faceted surface): 36 runs of one line per trim pass
+  // would cost 36 pierces; the 1.7 mm shared stretches between them are cut through instead.
+  LayerOutline o = make_outline(
+      [] {
+        std::vector<Eigen::Vector2d> b;
+        for (int j = 0; j < 72; ++j) b.emplace_back(20 * std::cos(j * std::numbers::pi / 36), 20 * std::sin(j * std::numbers::pi / 36));
+        return b;
+      }(),
+      [] {
+        std::vector<Eigen::Vector2d> n;
+        for (int j = 0; j < 72; ++j) n.emplace_back(std::cos(j * std::numbers::pi / 36), std::sin(j * std::numbers::pi / 36));
+        return n;
+      }(),
+      3,
+      [](int pass, std::size_t s) {
+        if (s % 2) return Offsets{0.0, -1.0};
+        const Offsets tangents[3] = {{-2.0, 0.5}, {0.2, 0.2}, {0.5, -2.0}};
+        return tangents[pass];
+      },
+      0.0, 8.0);
+  auto f = one_part(make_layer(0, 0.0, 8.0, {o}), 0.0, {100, 100}, 0.8);
+  ToolpathParams p = params_with_kerf(0.8);
+  auto tp = plan_sheet_toolpath(f.plan, f.parts, f.sheet, aluminium(), p);
+  ASSERT_TRUE(tp) << tp.error().message;
+  ASSERT_EQ(tp->contours.size(), 3u);  // one bridged run per trim pass, then the freeing pass
+  EXPECT_FALSE(tp->contours[0].closed);
+  EXPECT_FALSE(tp->contours[1].closed);
+  EXPECT_TRUE(tp->contours[2].closed && tp->contours[2].frees);
+  // With a free pierce (no dwell, no leads) the stretches are not worth crossing: one run each.
+  p.pierce_dwell_s = 0.0;
+  p.lead_in_mm = p.lead_out_mm = 0.0;
+  tp = plan_sheet_toolpath(f.plan, f.parts, f.sheet, aluminium(), p);
+  ASSERT_TRUE(tp) << tp.error().message;
+  EXPECT_EQ(tp->contours.size(), 2u * 36u + 1u);
+}
+
 TEST(Toolpath, ATrimPassThatWouldFreeThePartLeavesABridge) {
   auto f = one_part(make_layer(0, 0.0, 8.0, {half_convex_disc(true)}), 0.0, {100, 100}, 0.8);
   ToolpathParams p = params_with_kerf(0.8);
