@@ -129,10 +129,7 @@ class SheetBuilder {
   }
 
   std::expected<void, Error> cut_placement(int placement_index) {
-    const Placement& pl = sheet_.placements[static_cast<std::size_t>(placement_index)];
-    if (pl.part < 0 || static_cast<std::size_t>(pl.part) >= parts_.size())
-      return std::unexpected(invalid(fmt::format("sheet {}: placement {} names part {} of {}", sheet_.index,
-                                                 placement_index, pl.part, parts_.size())));
+    const Placement& pl = sheet_.placements[static_cast<std::size_t>(placement_index)];  // checked by cutting_order
     const Part& part = parts_[static_cast<std::size_t>(pl.part)];
     if (part.layer_slot < 0 || static_cast<std::size_t>(part.layer_slot) >= plan_.layers.size())
       return std::unexpected(invalid(fmt::format("part {}: layer slot {} is not in the plan", part_label(part), part.layer_slot)));

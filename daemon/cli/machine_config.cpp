@@ -1,26 +1,20 @@
 #include "machine_config.hpp"
 
 #include <fmt/format.h>
-#include <toml++/toml.h>
+#include "toml_file.hpp"
 
 #include <cmath>
 #include <cstdlib>
-#include <fstream>
 #include <functional>
 #include <map>
 #include <numbers>
 #include <optional>
-#include <sstream>
 #include <vector>
 
 namespace lamina::cli {
 namespace {
 
 constexpr double kDeg = std::numbers::pi / 180.0;  // the one degree → radian factor of this file
-
-Error parse_error(const std::string& source, const toml::source_region& where, const std::string& what) {
-  return {ErrorCode::parse_error, fmt::format("{}:{}: {}", source, where.begin.line, what)};
-}
 
 // One key of a section: reads its node into the config, or says what is wrong with it.
 using Reader = std::function<std::optional<std::string>(const toml::node&, MachineConfig&)>;
@@ -162,12 +156,9 @@ std::map<std::string, Section, std::less<>> sections() {
 }  // namespace
 
 std::expected<MachineConfig, Error> parse_machine_toml(std::string_view text_in, const std::string& source) {
-  toml::table doc;
-  try {
-    doc = toml::parse(text_in, source);
-  } catch (const toml::parse_error& e) {
-    return std::unexpected(parse_error(source, e.source(), std::string(e.description())));
-  }
+  auto parsed = parse_toml(text_in, source);
+  if (!parsed) return std::unexpected(parsed.error());
+  const toml::table& doc = *parsed;
   MachineConfig c;
   c.head.a_min_rad = -c.head.a_max_rad;
   const auto known = sections();
@@ -176,21 +167,21 @@ std::expected<MachineConfig, Error> parse_machine_toml(std::string_view text_in,
     if (sec == known.end()) {
       std::vector<std::string> names;
       for (const auto& [n, _] : known) names.push_back(n);
-      return std::unexpected(parse_error(source, name.source(), fmt::format("unknown section [{}] (known: {})", name.str(),
+      return std::unexpected(toml_error(source, name.source(), fmt::format("unknown section [{}] (known: {})", name.str(),
                                                                              fmt::join(names, ", "))));
     }
     const auto* table = node.as_table();
-    if (!table) return std::unexpected(parse_error(source, node.source(), fmt::format("{} must be a [{}] table", name.str(), name.str())));
+    if (!table) return std::unexpected(toml_error(source, node.source(), fmt::format("{} must be a [{}] table", name.str(), name.str())));
     for (const auto& [key, value] : *table) {
       const auto r = sec->second.find(key.str());
       if (r == sec->second.end()) {
         std::vector<std::string> keys;
         for (const auto& [k, _] : sec->second) keys.push_back(k);
-        return std::unexpected(parse_error(source, key.source(), fmt::format("unknown key '{}' in [{}] (known: {})", key.str(),
+        return std::unexpected(toml_error(source, key.source(), fmt::format("unknown key '{}' in [{}] (known: {})", key.str(),
                                                                               name.str(), fmt::join(keys, ", "))));
       }
       if (auto problem = r->second(value, c))
-        return std::unexpected(parse_error(source, value.source(), fmt::format("[{}] {} {}", name.str(), key.str(), *problem)));
+        return std::unexpected(toml_error(source, value.source(), fmt::format("[{}] {} {}", name.str(), key.str(), *problem)));
     }
   }
   if (c.cutting.feed.min_feed_mm_per_s > c.cutting.feed.max_feed_mm_per_s)
@@ -201,12 +192,9 @@ std::expected<MachineConfig, Error> parse_machine_toml(std::string_view text_in,
 }
 
 std::expected<MachineConfig, Error> read_machine_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return std::unexpected(Error{ErrorCode::io_error, fmt::format("cannot read machine file {}", path)});
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) return std::unexpected(Error{ErrorCode::io_error, fmt::format("cannot read machine file {}", path)});
-  return parse_machine_toml(text.view(), path);
+  auto text = read_config_file(path, "machine");
+  if (!text) return std::unexpected(text.error());
+  return parse_machine_toml(*text, path);
 }
 
 std::string default_config_dir() {

@@ -1,19 +1,13 @@
 #include "materials_config.hpp"
 
 #include <fmt/format.h>
-#include <toml++/toml.h>
+#include "toml_file.hpp"
 
 #include <cmath>
-#include <fstream>
 #include <optional>
-#include <sstream>
 
 namespace lamina::cli {
 namespace {
-
-Error parse_error(const std::string& source, const toml::source_region& where, const std::string& what) {
-  return {ErrorCode::parse_error, fmt::format("{}:{}: {}", source, where.begin.line, what)};
-}
 
 // A key of the file: its unit conversion to the SI field and its allowed range (in file units).
 struct NumberKey {
@@ -28,10 +22,10 @@ std::expected<double, Error> number(const std::string& source, const NumberKey& 
   std::optional<double> v;
   if (const auto* i = node.as_integer()) v = static_cast<double>(i->get());
   if (const auto* f = node.as_floating_point()) v = f->get();
-  if (!v) return std::unexpected(parse_error(source, node.source(), fmt::format("{} must be a number", k.key)));
+  if (!v) return std::unexpected(toml_error(source, node.source(), fmt::format("{} must be a number", k.key)));
   const bool above = k.low_inclusive ? *v >= k.low : *v > k.low;
   if (!std::isfinite(*v) || !above || *v > k.high)
-    return std::unexpected(parse_error(source, node.source(),
+    return std::unexpected(toml_error(source, node.source(),
                                        fmt::format("{} = {} is out of range (must be in {}{}, {}])", k.key, *v,
                                                    k.low_inclusive ? "[" : "(", k.low, k.high)));
   return *v * k.to_si;
@@ -60,7 +54,7 @@ std::expected<JetSetup, Error> read_jet(const std::string& source, const toml::t
                         std::pair{&kDischarge, &jet.discharge_coefficient}})
       if (k == s->key) spec = s, field = f;
     if (!spec)
-      return std::unexpected(parse_error(
+      return std::unexpected(toml_error(
           source, key.source(),
           fmt::format("unknown key '{}' in [jet] (known: pressure_mpa, orifice_diameter_mm, focus_diameter_mm, "
                       "abrasive_g_per_min, water_density_kg_per_m3, discharge_coefficient)",
@@ -80,7 +74,7 @@ std::expected<Material, Error> read_material(const std::string& source, const to
     if (k == "name") {
       const auto* s = node.as_string();
       if (!s || s->get().empty())
-        return std::unexpected(parse_error(source, node.source(), "name must be a non-empty string"));
+        return std::unexpected(toml_error(source, node.source(), "name must be a non-empty string"));
       m.name = s->get();
       has_name = true;
       continue;
@@ -91,7 +85,7 @@ std::expected<Material, Error> read_material(const std::string& source, const to
                         std::pair{&kMachinability, &m.machinability}})
       if (k == s->key) spec = s, field = f;
     if (!spec)
-      return std::unexpected(parse_error(
+      return std::unexpected(toml_error(
           source, key.source(),
           fmt::format("unknown key '{}' in [[material]] (known: name, density_kg_per_m3, specific_energy_j_per_mm3, "
                       "machinability)",
@@ -100,9 +94,9 @@ std::expected<Material, Error> read_material(const std::string& source, const to
     if (!v) return std::unexpected(v.error());
     *field = *v;
   }
-  if (!has_name) return std::unexpected(parse_error(source, t.source(), "[[material]] without name"));
+  if (!has_name) return std::unexpected(toml_error(source, t.source(), "[[material]] without name"));
   if (m.specific_energy_j_per_m3 == 0.0 && m.machinability == 0.0)
-    return std::unexpected(parse_error(
+    return std::unexpected(toml_error(
         source, t.source(),
         fmt::format("material '{}' has neither specific_energy_j_per_mm3 nor machinability: no feed model can use it", m.name)));
   return m;
@@ -111,18 +105,15 @@ std::expected<Material, Error> read_material(const std::string& source, const to
 }  // namespace
 
 std::expected<MaterialsConfig, Error> parse_materials_toml(std::string_view text, const std::string& source_name) {
-  toml::table doc;
-  try {
-    doc = toml::parse(text, source_name);
-  } catch (const toml::parse_error& e) {
-    return std::unexpected(parse_error(source_name, e.source(), std::string(e.description())));
-  }
+  auto parsed = parse_toml(text, source_name);
+  if (!parsed) return std::unexpected(parsed.error());
+  const toml::table& doc = *parsed;
   MaterialsConfig config;
   for (const auto& [key, node] : doc) {
     const std::string_view k = key.str();
     if (k == "jet") {
       const auto* t = node.as_table();
-      if (!t) return std::unexpected(parse_error(source_name, node.source(), "jet must be a table: [jet]"));
+      if (!t) return std::unexpected(toml_error(source_name, node.source(), "jet must be a table: [jet]"));
       auto jet = read_jet(source_name, *t);
       if (!jet) return std::unexpected(jet.error());
       config.jet = *jet;
@@ -130,16 +121,16 @@ std::expected<MaterialsConfig, Error> parse_materials_toml(std::string_view text
       const auto* list = node.as_array();
       if (!list || !list->is_array_of_tables())
         return std::unexpected(
-            parse_error(source_name, node.source(), "material must be written [[material]], one table per material"));
+            toml_error(source_name, node.source(), "material must be written [[material]], one table per material"));
       for (const toml::node& entry : *list) {
         auto m = read_material(source_name, *entry.as_table());
         if (!m) return std::unexpected(m.error());
         if (config.materials.contains(m->name))
-          return std::unexpected(parse_error(source_name, entry.source(), fmt::format("material '{}' given twice", m->name)));
+          return std::unexpected(toml_error(source_name, entry.source(), fmt::format("material '{}' given twice", m->name)));
         config.materials.emplace(m->name, std::move(*m));
       }
     } else {
-      return std::unexpected(parse_error(
+      return std::unexpected(toml_error(
           source_name, key.source(), fmt::format("unknown key '{}' (the file holds [jet] and [[material]] tables)", k)));
     }
   }
@@ -149,12 +140,9 @@ std::expected<MaterialsConfig, Error> parse_materials_toml(std::string_view text
 }
 
 std::expected<MaterialsConfig, Error> load_materials(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return std::unexpected(Error{ErrorCode::io_error, fmt::format("cannot read materials file {}", path)});
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) return std::unexpected(Error{ErrorCode::io_error, fmt::format("cannot read materials file {}", path)});
-  return parse_materials_toml(text.view(), path);
+  auto text = read_config_file(path, "materials");
+  if (!text) return std::unexpected(text.error());
+  return parse_materials_toml(*text, path);
 }
 
 std::expected<Material, Error> find_material(const MaterialsConfig& config, std::string_view name) {

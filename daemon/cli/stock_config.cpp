@@ -1,21 +1,15 @@
 #include "stock_config.hpp"
 
 #include <fmt/format.h>
-#include <toml++/toml.h>
+#include "toml_file.hpp"
 
 #include <cmath>
-#include <fstream>
 #include <optional>
-#include <sstream>
 
 namespace lamina::cli {
 namespace {
 
 constexpr std::string_view kKnownKeys = "thickness_mm, width_mm, length_mm, count, material";
-
-Error parse_error(const std::string& source, const toml::source_region& where, const std::string& what) {
-  return {ErrorCode::parse_error, fmt::format("{}:{}: {}", source, where.begin.line, what)};
-}
 
 // A length in mm: a TOML integer or float, finite, >= 0 (> 0 when `positive`).
 std::expected<double, Error> length_mm(const std::string& source, std::string_view key, const toml::node& node,
@@ -23,10 +17,10 @@ std::expected<double, Error> length_mm(const std::string& source, std::string_vi
   std::optional<double> v;
   if (const auto* i = node.as_integer()) v = static_cast<double>(i->get());
   if (const auto* f = node.as_floating_point()) v = f->get();
-  if (!v) return std::unexpected(parse_error(source, node.source(), fmt::format("{} must be a number of millimetres", key)));
+  if (!v) return std::unexpected(toml_error(source, node.source(), fmt::format("{} must be a number of millimetres", key)));
   if (!std::isfinite(*v) || *v < 0.0 || (positive && *v == 0.0))
     return std::unexpected(
-        parse_error(source, node.source(), fmt::format("{} = {} is out of range (must be {} 0)", key, *v, positive ? ">" : ">=")));
+        toml_error(source, node.source(), fmt::format("{} = {} is out of range (must be {} 0)", key, *v, positive ? ">" : ">=")));
   return *v;
 }
 
@@ -43,38 +37,35 @@ std::expected<SheetStock, Error> read_sheet(const std::string& source, const tom
     } else if (k == "count") {
       const auto* i = node.as_integer();
       if (!i || i->get() < 0 || i->get() > 1'000'000)
-        return std::unexpected(parse_error(source, node.source(), "count must be a whole number of sheets, 0 … 1000000"));
+        return std::unexpected(toml_error(source, node.source(), "count must be a whole number of sheets, 0 … 1000000"));
       s.count = static_cast<int>(i->get());
     } else if (k == "material") {
       const auto* m = node.as_string();
-      if (!m) return std::unexpected(parse_error(source, node.source(), "material must be a string"));
+      if (!m) return std::unexpected(toml_error(source, node.source(), "material must be a string"));
       s.material = m->get();
     } else {
       return std::unexpected(
-          parse_error(source, key.source(), fmt::format("unknown key '{}' in [[sheet]] (known: {})", k, kKnownKeys)));
+          toml_error(source, key.source(), fmt::format("unknown key '{}' in [[sheet]] (known: {})", k, kKnownKeys)));
     }
   }
-  if (!has_thickness) return std::unexpected(parse_error(source, t.source(), "[[sheet]] without thickness_mm"));
+  if (!has_thickness) return std::unexpected(toml_error(source, t.source(), "[[sheet]] without thickness_mm"));
   return s;
 }
 
 }  // namespace
 
 std::expected<Stock, Error> parse_stock_toml(std::string_view text, const std::string& source_name) {
-  toml::table doc;
-  try {
-    doc = toml::parse(text, source_name);
-  } catch (const toml::parse_error& e) {
-    return std::unexpected(parse_error(source_name, e.source(), std::string(e.description())));
-  }
+  auto parsed = parse_toml(text, source_name);
+  if (!parsed) return std::unexpected(parsed.error());
+  const toml::table& doc = *parsed;
   Stock stock;
   for (const auto& [key, node] : doc) {
     if (key.str() != "sheet")
-      return std::unexpected(parse_error(source_name, key.source(),
+      return std::unexpected(toml_error(source_name, key.source(),
                                          fmt::format("unknown key '{}' (the file holds [[sheet]] tables only)", key.str())));
     const auto* sheets = node.as_array();
     if (!sheets || !sheets->is_array_of_tables())
-      return std::unexpected(parse_error(source_name, node.source(), "sheet must be written [[sheet]], one table per kind of sheet"));
+      return std::unexpected(toml_error(source_name, node.source(), "sheet must be written [[sheet]], one table per kind of sheet"));
     for (const toml::node& entry : *sheets) {
       auto sheet = read_sheet(source_name, *entry.as_table());
       if (!sheet) return std::unexpected(sheet.error());
@@ -87,12 +78,9 @@ std::expected<Stock, Error> parse_stock_toml(std::string_view text, const std::s
 }
 
 std::expected<Stock, Error> read_stock_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return std::unexpected(Error{ErrorCode::io_error, fmt::format("cannot read stock file {}", path)});
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) return std::unexpected(Error{ErrorCode::io_error, fmt::format("cannot read stock file {}", path)});
-  return parse_stock_toml(text.view(), path);
+  auto text = read_config_file(path, "stock");
+  if (!text) return std::unexpected(text.error());
+  return parse_stock_toml(*text, path);
 }
 
 Stock sheets_of_unknown_size(std::span<const double> thicknesses_mm) {

@@ -7,6 +7,7 @@
 
 #include <Eigen/Core>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <numbers>
@@ -124,6 +125,39 @@ inline TriangleSoup frustum(double r0, double r1, double h, int segments) {
     tri(bottom, p(j + 1, r0, 0), p(j, r0, 0));
   }
   return s;
+}
+
+// An axis-aligned square outline of half-width `half` about `centre` with vertical walls:
+// stations at the corners (diagonal normals) and mid-edges, CCW with outward normals, or for a
+// hole CW with normals into the hole.
+inline LayerOutline square_outline(Eigen::Vector2d centre, double half, double z_bottom, double z_top, bool hole = false,
+                                   int parent = -1) {
+  std::vector<Eigen::Vector2d> base, normals;
+  const Eigen::Vector2d corners[4] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
+  for (int k = 0; k < 4; ++k) {
+    const Eigen::Vector2d a = corners[k], b = corners[(k + 1) % 4];
+    base.push_back(centre + half * a);
+    normals.push_back(a.normalized());
+    base.push_back(centre + half * 0.5 * (a + b));
+    normals.push_back(Eigen::Vector2d((b - a).y(), -(b - a).x()).normalized());
+  }
+  if (hole) {
+    std::reverse(base.begin(), base.end());
+    std::reverse(normals.begin(), normals.end());
+    for (auto& n : normals) n = -n;
+  }
+  return make_outline(base, normals, 1, [](int, std::size_t) { return Offsets{0, 0}; }, z_bottom, z_top, hole, parent);
+}
+
+// n stations on a circle of radius r about the origin (angles 2πj/n), CCW, and their outward normals.
+inline std::pair<std::vector<Eigen::Vector2d>, std::vector<Eigen::Vector2d>> circle_stations(double r, int n) {
+  std::vector<Eigen::Vector2d> base, normals;
+  for (int j = 0; j < n; ++j) {
+    const Eigen::Vector2d u(std::cos(2.0 * std::numbers::pi * j / n), std::sin(2.0 * std::numbers::pi * j / n));
+    base.push_back(r * u);
+    normals.push_back(u);
+  }
+  return {base, normals};
 }
 
 }  // namespace lamina::dev_test

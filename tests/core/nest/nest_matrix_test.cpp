@@ -78,22 +78,5 @@ TEST(NestMatrix, UprightInATallRow) {
   EXPECT_NEAR(ymin, 5.0, 1e-9) << "same row as the first part";
 }
 
-TEST(NestMatrix, MixedShapesAllInvariants) {
-  std::vector<Part> parts;
-  int island = 1;
-  for (int i = 0; i < 6; ++i) parts.push_back(make_part(rect(120 + 10 * i, 40 + 7 * i, 50, 50), 1.0, 1, island++));
-  for (int i = 0; i < 6; ++i) parts.push_back(make_part(ell(150, 90, 30, -20, 5), 1.0, 2, island++));
-  for (int i = 0; i < 6; ++i) parts.push_back(make_part(circle(35 + 3 * i), 1.0, 3, island++));
-  // Rings: outer circle footprint, the hole only lowers the area.
-  for (int i = 0; i < 4; ++i)
-    parts.push_back(make_part(circle(60, 64, 400, 400), 1.0, 4, island++, std::numbers::pi * 30 * 30));
-  const Stock stock = one_sheet_kind(1.0, 600, 400);
-  auto nest = nest_parts(parts, stock, matrix());
-  ASSERT_TRUE(nest) << nest.error().message;
-  const Summary s = check_nest(parts, stock, matrix(), *nest);
-  std::printf("[matrix] %zu mixed parts: %d sheets, mean utilisation %.3f\n", parts.size(), s.sheets,
-              s.mean_utilisation);
-}
-
 }  // namespace
 }  // namespace lamina

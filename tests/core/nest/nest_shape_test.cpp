@@ -44,7 +44,8 @@ TEST(NestShape, PlacementReproducesLibnest2dTransform) {
   EXPECT_TRUE(turned) << "a test of the rotation needs a turned part";
 }
 
-TEST(NestShape, AllInvariantsOnMixedParts) {
+// Rectangles, L-shapes, discs and rings together: every invariant, for both methods.
+TEST(NestShape, AllInvariantsOnMixedPartsForBothMethods) {
   std::vector<Part> parts;
   int island = 1;
   for (int i = 0; i < 6; ++i) parts.push_back(make_part(rect(120 + 10 * i, 40 + 7 * i, 50, 50), 1.0, 1, island++));

@@ -17,33 +17,12 @@ using dev_test::make_layer;
 using dev_test::make_outline;
 using dev_test::Offsets;
 
-// An axis-aligned square outline (4 corner stations plus mid-edge ones), CCW with outward normals
-// (or CW with normals into the hole), vertical walls.
-LayerOutline square(Eigen::Vector2d centre, double half, double z0, double z1, bool hole = false, int parent = -1) {
-  std::vector<Eigen::Vector2d> base, normals;
-  const Eigen::Vector2d corners[4] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
-  for (int k = 0; k < 4; ++k) {
-    const Eigen::Vector2d a = corners[k], b = corners[(k + 1) % 4];
-    const Eigen::Vector2d edge_n = Eigen::Vector2d((b - a).y(), -(b - a).x()).normalized();
-    base.push_back(centre + half * a);
-    normals.push_back(a.normalized());
-    base.push_back(centre + half * 0.5 * (a + b));
-    normals.push_back(edge_n);
-  }
-  if (hole) {
-    std::reverse(base.begin(), base.end());
-    std::reverse(normals.begin(), normals.end());
-    for (auto& n : normals) n = -n;
-  }
-  return make_outline(base, normals, 1, [](int, std::size_t) { return Offsets{0, 0}; }, z0, z1, hole, parent);
-}
-
 TEST(Parts, OuterWithItsHolesIsOnePartAndIslandsAreNumbered) {
   BevelPlan plan;
   // Layer 3: a 40 mm square with a 10 mm square hole, and a separate 10 mm square island.
   plan.layers.push_back(make_layer(3, 10.0, 5.0,
-                                   {square({0, 0}, 20, 10, 15), square({0, 0}, 5, 10, 15, true, 0),
-                                    square({50, 0}, 5, 10, 15)}));
+                                   {dev_test::square_outline({0, 0}, 20, 10, 15), dev_test::square_outline({0, 0}, 5, 10, 15, true, 0),
+                                    dev_test::square_outline({50, 0}, 5, 10, 15)}));
   PartParams params;
   params.kerf_mm = 1.0;
   auto parts = make_parts(plan, params);

@@ -19,25 +19,6 @@ using dev_test::make_layer;
 using dev_test::make_outline;
 using dev_test::Offsets;
 
-// Square outline of half-width `half` about `centre`, stations at corners and mid-edges.
-LayerOutline square(Eigen::Vector2d centre, double half, double z0, double z1, bool hole = false, int parent = -1) {
-  std::vector<Eigen::Vector2d> base, normals;
-  const Eigen::Vector2d corners[4] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
-  for (int k = 0; k < 4; ++k) {
-    const Eigen::Vector2d a = corners[k], b = corners[(k + 1) % 4];
-    base.push_back(centre + half * a);
-    normals.push_back(a.normalized());
-    base.push_back(centre + half * 0.5 * (a + b));
-    normals.push_back(Eigen::Vector2d((b - a).y(), -(b - a).x()).normalized());
-  }
-  if (hole) {
-    std::reverse(base.begin(), base.end());
-    std::reverse(normals.begin(), normals.end());
-    for (auto& n : normals) n = -n;
-  }
-  return make_outline(base, normals, 1, [](int, std::size_t) { return Offsets{0, 0}; }, z0, z1, hole, parent);
-}
-
 Material aluminium() {
   Material m;
   m.name = "aluminium";
@@ -100,7 +81,7 @@ double to_square(const Eigen::Vector2d& p, const Eigen::Vector2d& c, double half
 
 TEST(Toolpath, HolesFirstThenTheOuterWithKerfAndLeadsInTheScrap) {
   const double kerf = 1.0, h = 0.5;
-  auto f = one_part(make_layer(0, 0.0, 5.0, {square({0, 0}, 20, 0, 5), square({0, 0}, 5, 0, 5, true, 0)}),
+  auto f = one_part(make_layer(0, 0.0, 5.0, {dev_test::square_outline({0, 0}, 20, 0, 5), dev_test::square_outline({0, 0}, 5, 0, 5, true, 0)}),
                     std::numbers::pi / 2, {100, 50}, kerf);
   auto tp = plan_sheet_toolpath(f.plan, f.parts, f.sheet, aluminium(), params_with_kerf(kerf));
   ASSERT_TRUE(tp) << tp.error().message;
@@ -224,7 +205,7 @@ TEST(Toolpath, FeedsFollowTheModelAtEachLinesTilt) {
 }
 
 TEST(Toolpath, SharpCornersAreEnteredSlower) {
-  auto f = one_part(make_layer(0, 0.0, 5.0, {square({0, 0}, 20, 0, 5)}), 0.0, {100, 100}, 0.0);
+  auto f = one_part(make_layer(0, 0.0, 5.0, {dev_test::square_outline({0, 0}, 20, 0, 5)}), 0.0, {100, 100}, 0.0);
   ToolpathParams p = params_with_kerf(0.0);
   auto tp = plan_sheet_toolpath(f.plan, f.parts, f.sheet, aluminium(), p);
   ASSERT_TRUE(tp);
@@ -245,17 +226,9 @@ TEST(Toolpath, SharpCornersAreEnteredSlower) {
 
 // An outline whose convex half (stations with y > 0) has three tangent cuts and whose other half one.
 LayerOutline half_convex_disc(bool convex_everywhere) {
+  const auto disc = dev_test::circle_stations(20.0, 72);
   return make_outline(
-      [] {
-        std::vector<Eigen::Vector2d> b;
-        for (int j = 0; j < 72; ++j) b.emplace_back(20 * std::cos(j * std::numbers::pi / 36), 20 * std::sin(j * std::numbers::pi / 36));
-        return b;
-      }(),
-      [] {
-        std::vector<Eigen::Vector2d> n;
-        for (int j = 0; j < 72; ++j) n.emplace_back(std::cos(j * std::numbers::pi / 36), std::sin(j * std::numbers::pi / 36));
-        return n;
-      }(),
+      disc.first, disc.second,
       3,
       [convex_everywhere](int pass, std::size_t s) {
         const bool convex = convex_everywhere || (s > 0 && s < 36);
@@ -290,17 +263,9 @@ TEST(Toolpath, TrimRunsComeBeforeTheFreeingPassAndStartOnItsSurface) {
 TEST(Toolpath, TrimRunsSplitByShortSharedStretchesAreCutAsOne) {
   // Every other station convex (as on a faceted surface): 36 runs of one line per trim pass
   // would cost 36 pierces; the 1.7 mm shared stretches between them are cut through instead.
+  const auto disc = dev_test::circle_stations(20.0, 72);
   LayerOutline o = make_outline(
-      [] {
-        std::vector<Eigen::Vector2d> b;
-        for (int j = 0; j < 72; ++j) b.emplace_back(20 * std::cos(j * std::numbers::pi / 36), 20 * std::sin(j * std::numbers::pi / 36));
-        return b;
-      }(),
-      [] {
-        std::vector<Eigen::Vector2d> n;
-        for (int j = 0; j < 72; ++j) n.emplace_back(std::cos(j * std::numbers::pi / 36), std::sin(j * std::numbers::pi / 36));
-        return n;
-      }(),
+      disc.first, disc.second,
       3,
       [](int pass, std::size_t s) {
         if (s % 2) return Offsets{0.0, -1.0};
