@@ -1,0 +1,91 @@
+#pragma once
+// One G-code line as the simulated controller reads it: words, modal commands and the Grbl
+// status code a real controller would answer. The simulator's own parser: it shares nothing
+// with core/post or drivers/ on purpose (an independent peer catches misunderstandings).
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace lamina::sim {
+
+// Grbl / grblHAL status codes (grblHAL core errors.h numbering) for the errors the simulator
+// implements. Sent as `error:N`.
+enum class GrblStatus : int {
+  ok = 0,
+  expected_command_letter = 1,
+  bad_number_format = 2,
+  invalid_statement = 3,      // unknown $ command
+  negative_value = 4,
+  idle_error = 8,             // $ command that needs Idle
+  system_gc_lock = 9,         // G-code refused: alarm or error lock
+  soft_limit = 10,
+  overflow = 11,              // line longer than the line buffer
+  unsupported_command = 20,   // unknown G/M code or a letter this machine has no axis for (B)
+  modal_group_violation = 21,
+  undefined_feed_rate = 22,
+  command_value_not_integer = 23,
+  word_repeated = 25,
+  no_axis_words = 26,
+  invalid_line_number = 27,
+  value_word_missing = 28,
+  invalid_target = 33,
+  arc_radius_error = 34,
+  unused_words = 36,
+  value_out_of_range = 39,
+};
+
+// Grbl / grblHAL alarm codes the simulator raises (`ALARM:N`).
+enum class GrblAlarm : int {
+  hard_limit = 1,
+  soft_limit = 2,
+  abort_cycle = 3,  // reset while moving: position may be lost
+  estop = 10,
+};
+
+inline constexpr int kAxisCount = 5;  // X Y Z A C
+// Machine position: X, Y, Z in mm; A, C in degrees (as the controller reports them).
+using AxisValues = std::array<double, kAxisCount>;
+inline constexpr std::array<char, kAxisCount> kAxisLetters{'X', 'Y', 'Z', 'A', 'C'};
+
+enum class MotionMode { none, rapid, linear, arc_cw, arc_ccw, dwell };
+
+// What one line asks for, after parsing and validation against the modal state it will run in.
+struct Block {
+  std::string source;                       // the line as received (no end-of-line)
+  std::optional<std::int64_t> line_number;  // N word
+  MotionMode motion = MotionMode::none;     // motion in this block (G0/G1/G2/G3 modal or G4)
+  std::array<std::optional<double>, kAxisCount> axis_words;  // as written (units of the block)
+  std::optional<double> i_mm, j_mm, k_mm, r_mm;              // arc words, converted to mm
+  std::optional<double> feed_word;                           // F as written
+  std::optional<double> dwell_s;                             // G4 P (seconds, Grbl convention)
+  std::optional<bool> set_inches;                            // G20 true / G21 false
+  std::optional<bool> set_relative;                          // G91 true / G90 false
+  std::optional<bool> set_inverse_time;                      // G93 true / G94 false
+  std::optional<bool> jet_on;                                // configured jet-on / jet-off M-code
+  bool program_end = false;                                  // M2 / M30
+  bool percent = false;                                      // a `%` program delimiter line
+  bool comment_only = false;                                 // nothing but comments / blank
+};
+
+struct ParseParams {
+  std::vector<int> jet_on_mcodes{3};
+  std::vector<int> jet_off_mcodes{5};
+  std::size_t max_line_chars = 256;  // grblHAL LINE_BUFFER_SIZE is 257 with the terminator
+};
+
+struct ParseResult {
+  GrblStatus status = GrblStatus::ok;
+  Block block;
+};
+
+// Parse one line (without its end-of-line). Words are case-insensitive, spaces ignored,
+// `( )` and `;` comments skipped, N numbers kept. Unknown letters (B on an XYZAC machine,
+// E, U, …) → unsupported_command; bad numbers → bad_number_format; a repeated word →
+// word_repeated; two motion commands → modal_group_violation. Checks that need the modal
+// state (feed missing, G93 without F) are the executor's.
+ParseResult parse_block(std::string_view line, const ParseParams& params);
+
+}  // namespace lamina::sim

@@ -1,0 +1,100 @@
+#pragma once
+// The simulated CNC's motion side: modal state, a finite planner queue, a time model, soft
+// limits, feed hold / resume / reset, alarms and the record of every executed block.
+// Pure and single-threaded: every call takes the simulated time `now_s` (seconds since the
+// simulator started, already multiplied by --time-scale); nothing here reads a clock.
+#include <cstdint>
+#include <deque>
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "gcode_block.hpp"
+
+namespace lamina::sim {
+
+struct MachineConfig {
+  AxisValues soft_min{0, 0, -150, -120, -1e9};  // mm, mm, mm, deg, deg
+  AxisValues soft_max{3000, 2000, 50, 120, 1e9};
+  bool soft_limits = true;
+  AxisValues rapid_per_min{20000, 20000, 5000, 7200, 7200};  // mm/min or deg/min per axis
+  double max_feed_mm_per_min = 20000;       // feeds above are clamped, as a controller does
+  double hold_decel_mm_per_s2 = 500;        // feed hold deceleration
+  std::size_t planner_blocks = 100;         // queue capacity, every accepted block counts
+  ParseParams parse;
+  // Fault injection: raise `alarm_code` when block number `alarm_at_seq` (1-based count of
+  // accepted blocks) starts executing.
+  std::optional<std::uint64_t> alarm_at_seq;
+  GrblAlarm alarm_at_seq_code = GrblAlarm::hard_limit;
+};
+
+enum class MachineState { idle, run, hold_pending, hold, alarm };
+
+// One block the machine executed (or started and was cut short by a reset or an alarm).
+struct ExecutedBlock {
+  std::uint64_t seq = 0;           // 1-based count of blocks accepted since start
+  std::string line;                // the source text as received
+  AxisValues start{}, end{};       // machine position when it started / ended
+  bool jet = false;                // commanded jet state while it ran (after an M-code block)
+  double t_start_s = 0, t_end_s = 0;
+  bool completed = true;           // false: stopped part-way (end = where it stopped)
+};
+// The queue ran empty while a program was running (not held, not ended by M2/M30).
+struct StarvationEvent {
+  double t_s = 0;
+  std::uint64_t after_seq = 0;
+};
+struct AlarmEvent {
+  double t_s = 0;
+  GrblAlarm code{};
+  std::uint64_t seq = 0;  // block running or refused when it happened (0: none)
+};
+using MachineEvent = std::variant<ExecutedBlock, StarvationEvent, AlarmEvent>;
+
+class Machine {
+ public:
+  explicit Machine(MachineConfig config);
+
+  // Parse `line`, check it against the modal state and the soft limits, and queue it.
+  // The caller must only submit while has_room(). Blank / comment-only lines are queued too
+  // (zero time) so the execution log repeats the program line for line; `%` lines are not.
+  // A target outside the soft limits raises ALARM:2 (queue flushed, motion stopped) and
+  // returns soft_limit. In alarm every line is refused with system_gc_lock.
+  GrblStatus submit_line(std::string_view line, double now_s);
+  bool has_room() const;
+  std::size_t free_blocks() const;
+  std::size_t queued_blocks() const;
+
+  // Run the time model up to now_s: finish blocks, start the next ones, emit events.
+  void advance(double now_s);
+
+  // Real-time commands.
+  void feed_hold(double now_s);     // decelerate (hold_pending), then hold
+  void cycle_start(double now_s);   // resume from hold
+  // Soft reset: stop at once, flush the queue, reset modal state to defaults. Returns true
+  // when the machine was moving (the caller then raises ALARM:3 as Grbl does).
+  bool reset(double now_s);
+  void raise_alarm(GrblAlarm code, double now_s);  // stops motion, flushes, state alarm
+  bool unlock();                                   // $X: leave alarm (false if e-stop held)
+  void set_estop(bool pressed, double now_s);      // pressed → ALARM:10, unlock refused
+
+  MachineState state() const;
+  AxisValues position(double now_s) const;         // interpolated within the running block
+  double feed_mm_per_min(double now_s) const;      // current programmed feed while moving
+  std::optional<std::int64_t> line_number() const; // N of the running block, if any
+  std::uint64_t accepted_blocks() const;           // seq of the last accepted block
+  std::uint64_t executed_blocks() const;           // blocks finished
+  std::uint64_t starvation_count() const;
+  bool jet_commanded() const;                      // CNC jet output (M-code) right now
+  std::optional<GrblAlarm> alarm() const;
+
+  // Events since the last call, in order (for the execution log and the protocols).
+  std::vector<MachineEvent> take_events();
+
+ private:
+  MachineConfig config_;
+  // (implementation state: modal state, the queue, the running block, counters)
+};
+
+}  // namespace lamina::sim
