@@ -1,6 +1,111 @@
-// lamina-sim: placeholder until the process loop lands (issue 5, in progress).
+// lamina-sim: a software waterjet cell for tests and demos — a CNC on a PTY or TCP port
+// (grbl or xonxoff personality), a PLC on Modbus TCP, a time model, faults on request and an
+// execution log. See docs/simulator.md.
+#include <atomic>
+#include <csignal>
 #include <cstdio>
-int main() {
-  std::fputs("lamina-sim: not built yet\n", stderr);
-  return 2;
+#include <sstream>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+
+#include "sim_options.hpp"
+#include "sim_runtime.hpp"
+
+namespace {
+
+std::atomic<bool> g_stop{false};
+extern "C" void on_signal(int) { g_stop = true; }
+
+lamina::sim::AxisValues parse_axes(const std::string& text, const char* flag) {
+  lamina::sim::AxisValues out{};
+  std::stringstream in(text);
+  std::string item;
+  int i = 0;
+  while (std::getline(in, item, ',')) {
+    if (i >= lamina::sim::kAxisCount) break;
+    try {
+      out[static_cast<std::size_t>(i)] = std::stod(item);
+    } catch (const std::exception&) {
+      throw std::runtime_error(fmt::format("{} '{}': '{}' is not a number", flag, text, item));
+    }
+    ++i;
+  }
+  if (i != lamina::sim::kAxisCount || in.rdbuf()->in_avail() > 0)
+    throw std::runtime_error(fmt::format("{} '{}': expected 5 comma-separated numbers X,Y,Z,A,C", flag, text));
+  return out;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace lamina::sim;
+  SimOptions o;
+  CLI::App app{"lamina-sim: a simulated waterjet cell (CNC on a PTY/TCP, PLC on Modbus TCP)"};
+  std::string machine_file, soft_min, soft_max;
+  std::optional<std::uint64_t> drop_ok, alarm_at_line;
+  std::optional<double> heartbeat_timeout_ms;
+  std::size_t rx_buffer = 0, planner_blocks = 0;
+  bool no_soft_limits = false;
+  app.add_option("--personality", o.personality, "grbl (character counting) or xonxoff (Fanuc drip feed)")
+      ->check(CLI::IsMember({"grbl", "xonxoff"}));
+  app.add_option("--link", o.link_path, "make a PTY and symlink its slave here");
+  app.add_option("--tcp", o.tcp_address, "serve the CNC line on 127.0.0.1:PORT instead (0 = any port)");
+  app.add_option("--modbus", o.modbus_address, "PLC Modbus TCP server on 127.0.0.1:PORT");
+  app.add_option("--control", o.control_address, "fault/control socket on 127.0.0.1:PORT");
+  app.add_option("--log", o.log_path, "execution log, JSON lines");
+  app.add_option("--baud", o.baud, "emulated line speed, 8N1 (default 115200)");
+  app.add_option("--time-scale", o.time_scale, "run the machine K times faster than real time");
+  app.add_option("--rx-buffer", rx_buffer, "controller receive buffer in bytes (grbl 1024, classic Grbl 128)");
+  app.add_option("--planner-blocks", planner_blocks, "planner queue length in blocks (default 100)");
+  app.add_option("--machine", machine_file, "TOML file: soft limits, rapids, feeds, jet M-codes");
+  app.add_option("--soft-min", soft_min, "soft limits, lower: X,Y,Z,A,C (mm, deg)");
+  app.add_option("--soft-max", soft_max, "soft limits, upper: X,Y,Z,A,C (mm, deg)");
+  app.add_flag("--no-soft-limits", no_soft_limits, "do not check soft limits");
+  app.add_option("--heartbeat-timeout", heartbeat_timeout_ms, "PLC heartbeat watchdog in ms (0 = off)");
+  app.add_option("--pressure-ramp", o.plc.pressure_ramp_s, "seconds for the pump to reach its set point");
+  // Faults.
+  app.add_option("--drop-ok", drop_ok, "never send the k-th ok (1-based)");
+  app.add_option("--garble", o.faults.garble_probability, "flip a bit in each received byte with probability P");
+  app.add_option("--seed", o.faults.garble_seed, "seed for --garble");
+  app.add_option("--unplug-at-line", o.faults.unplug_at_line, "close the port once N lines were received");
+  app.add_option("--unplug-at", o.faults.unplug_at_s, "close the port at simulated time T (s)");
+  app.add_option("--replug-after", o.faults.replug_after_ms, "reopen the port this many ms after an unplug");
+  app.add_option("--alarm-at-line", alarm_at_line, "ALARM:1 when block N starts executing");
+  app.add_option("--estop-at", o.faults.estop_at_s, "press the e-stop at simulated time T (s)");
+  app.add_option("--pressure-drop-at", o.faults.pressure_drop_at_s, "pump pressure drops at simulated time T (s)");
+  app.add_option("--stall-at", o.faults.stall_at_s, "stop draining the receive buffer at simulated time T (s)");
+  app.add_option("--stall-for", o.faults.stall_ms, "… for this many ms (wall clock)");
+  CLI11_PARSE(app, argc, argv);
+
+  try {
+    if (!machine_file.empty()) apply_machine_file(machine_file, o);
+    if (rx_buffer) o.grbl.rx_buffer_bytes = o.xonxoff.buffer_bytes = rx_buffer;
+    if (o.personality == "xonxoff") {  // water marks follow the buffer: DC3 at ¾, DC1 at ¼
+      o.xonxoff.high_water_bytes = o.xonxoff.buffer_bytes * 3 / 4;
+      o.xonxoff.low_water_bytes = o.xonxoff.buffer_bytes / 4;
+    }
+    if (planner_blocks) o.machine.planner_blocks = planner_blocks;
+    if (!soft_min.empty()) o.machine.soft_min = parse_axes(soft_min, "--soft-min");
+    if (!soft_max.empty()) o.machine.soft_max = parse_axes(soft_max, "--soft-max");
+    if (no_soft_limits) o.machine.soft_limits = false;
+    if (heartbeat_timeout_ms) o.plc.heartbeat_timeout_s = *heartbeat_timeout_ms / 1000.0;
+    if (drop_ok) o.grbl.faults.drop_ok_index = o.xonxoff.faults.drop_ok_index = drop_ok;
+    if (alarm_at_line) o.machine.alarm_at_seq = alarm_at_line;
+    if (o.faults.garble_probability < 0 || o.faults.garble_probability > 1)
+      throw std::runtime_error("--garble: a probability in [0, 1]");
+
+    std::signal(SIGTERM, on_signal);
+    std::signal(SIGINT, on_signal);
+    std::signal(SIGPIPE, SIG_IGN);
+    SimRuntime sim(std::move(o));
+    // One JSON line on stdout tells a test (or the demo script) where everything is.
+    std::puts(sim.ready_info().dump().c_str());
+    std::fflush(stdout);
+    sim.run(g_stop);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "lamina-sim: %s\n", e.what());
+    return 1;
+  }
+  return 0;
 }

@@ -1,0 +1,34 @@
+#pragma once
+// Emulated line speed: a byte may cross the wire only when the wire has had time to carry it.
+// 8N1 framing puts 10 bits on the wire per byte, so baud/10 bytes per second. A small burst
+// allowance absorbs the event loop waking late without changing the long-run rate.
+#include <algorithm>
+#include <cstddef>
+
+namespace lamina::sim {
+
+class BytePacer {
+ public:
+  BytePacer(double bytes_per_s, double burst_s)
+      : bytes_per_s_(bytes_per_s), burst_bytes_(std::max(1.0, bytes_per_s * burst_s)) {}
+
+  // Bytes that may cross now (wall seconds). Credit accrues while the wire idles, capped.
+  std::size_t allowance(double now_s) {
+    if (last_s_ < 0) last_s_ = now_s;
+    credit_ = std::min(burst_bytes_, credit_ + (now_s - last_s_) * bytes_per_s_);
+    last_s_ = now_s;
+    return static_cast<std::size_t>(credit_);
+  }
+  void consume(std::size_t bytes) { credit_ -= static_cast<double>(bytes); }
+  // Seconds until one more byte may cross (for the loop's sleep).
+  double seconds_to_next_byte() const { return credit_ >= 1 ? 0 : (1 - credit_) / bytes_per_s_; }
+  double bytes_per_s() const { return bytes_per_s_; }
+
+ private:
+  double bytes_per_s_;
+  double burst_bytes_;
+  double credit_ = 0;
+  double last_s_ = -1;
+};
+
+}  // namespace lamina::sim

@@ -1,0 +1,89 @@
+#include "sim_options.hpp"
+
+#include <stdexcept>
+
+#include <fmt/format.h>
+#include <toml++/toml.h>
+
+namespace lamina::sim {
+namespace {
+
+std::string where(const std::string& path, const toml::node& node) {
+  return fmt::format("{}:{}", path, node.source().begin.line);
+}
+
+AxisValues read_axes(const std::string& path, const std::string& key, const toml::node& node) {
+  const auto* array = node.as_array();
+  if (!array || array->size() != kAxisCount)
+    throw std::runtime_error(fmt::format("{}: {} must be an array of 5 numbers (X Y Z A C)", where(path, node), key));
+  AxisValues out{};
+  for (int i = 0; i < kAxisCount; ++i) {
+    const auto value = (*array)[static_cast<std::size_t>(i)].value<double>();
+    if (!value) throw std::runtime_error(fmt::format("{}: {}[{}] is not a number", where(path, node), key, i));
+    out[static_cast<std::size_t>(i)] = *value;
+  }
+  return out;
+}
+
+double read_positive(const std::string& path, const std::string& key, const toml::node& node) {
+  const auto value = node.value<double>();
+  if (!value || !(*value > 0))
+    throw std::runtime_error(fmt::format("{}: {} must be a positive number", where(path, node), key));
+  return *value;
+}
+
+std::vector<int> read_codes(const std::string& path, const std::string& key, const toml::node& node) {
+  const auto* array = node.as_array();
+  if (!array || array->empty())
+    throw std::runtime_error(fmt::format("{}: {} must be a non-empty array of M numbers", where(path, node), key));
+  std::vector<int> out;
+  for (const auto& item : *array) {
+    const auto value = item.value<int64_t>();
+    if (!value || *value < 0 || *value > 999)
+      throw std::runtime_error(fmt::format("{}: {} holds something that is not an M number", where(path, node), key));
+    out.push_back(static_cast<int>(*value));
+  }
+  return out;
+}
+
+}  // namespace
+
+void apply_machine_file(const std::string& path, SimOptions& options) {
+  toml::table table;
+  try {
+    table = toml::parse_file(path);
+  } catch (const toml::parse_error& e) {
+    throw std::runtime_error(fmt::format("{}:{}: {}", path, e.source().begin.line, e.description()));
+  }
+  auto& m = options.machine;
+  for (const auto& [key_node, node] : table) {
+    const std::string key(key_node.str());
+    if (key == "soft_min") m.soft_min = read_axes(path, key, node);
+    else if (key == "soft_max") m.soft_max = read_axes(path, key, node);
+    else if (key == "soft_limits") {
+      const auto v = node.value<bool>();
+      if (!v) throw std::runtime_error(fmt::format("{}: soft_limits must be true or false", where(path, node)));
+      m.soft_limits = *v;
+    } else if (key == "rapid_per_min") m.rapid_per_min = read_axes(path, key, node);
+    else if (key == "max_feed_mm_per_min") m.max_feed_mm_per_min = read_positive(path, key, node);
+    else if (key == "hold_decel_mm_per_s2") m.hold_decel_mm_per_s2 = read_positive(path, key, node);
+    else if (key == "planner_blocks") m.planner_blocks = static_cast<std::size_t>(read_positive(path, key, node));
+    else if (key == "rx_buffer") {
+      const auto bytes = static_cast<std::size_t>(read_positive(path, key, node));
+      options.grbl.rx_buffer_bytes = bytes;
+      options.xonxoff.buffer_bytes = bytes;
+    } else if (key == "jet_on_mcodes") m.parse.jet_on_mcodes = read_codes(path, key, node);
+    else if (key == "jet_off_mcodes") m.parse.jet_off_mcodes = read_codes(path, key, node);
+    else if (key == "pressure_ramp_s") options.plc.pressure_ramp_s = read_positive(path, key, node);
+    else
+      throw std::runtime_error(fmt::format("{}: unknown key '{}' (known: soft_min soft_max soft_limits "
+                                           "rapid_per_min max_feed_mm_per_min hold_decel_mm_per_s2 "
+                                           "planner_blocks rx_buffer jet_on_mcodes jet_off_mcodes pressure_ramp_s)",
+                                           where(path, node), key));
+  }
+  for (int i = 0; i < kAxisCount; ++i)
+    if (!(m.soft_min[static_cast<std::size_t>(i)] < m.soft_max[static_cast<std::size_t>(i)]))
+      throw std::runtime_error(fmt::format("{}: soft_min of {} is not below soft_max", path, kAxisLetters[static_cast<std::size_t>(i)]));
+}
+
+}  // namespace lamina::sim

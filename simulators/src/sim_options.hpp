@@ -1,0 +1,47 @@
+#pragma once
+// Everything lamina-sim is told on its command line and in its --machine TOML file.
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "grbl_protocol.hpp"
+#include "machine.hpp"
+#include "plc.hpp"
+#include "xonxoff_protocol.hpp"
+
+namespace lamina::sim {
+
+// Faults scheduled from the command line. Times are simulated seconds since start (the same
+// clock as the execution log's t_start / t_end); lines count lines the CNC received.
+struct FaultSchedule {
+  std::optional<std::uint64_t> unplug_at_line;
+  std::optional<double> unplug_at_s;
+  std::optional<double> replug_after_ms;  // a new PTY / listener this long after an unplug
+  std::optional<double> estop_at_s;
+  std::optional<double> pressure_drop_at_s;
+  std::optional<double> stall_at_s;
+  double stall_ms = 0;
+  double garble_probability = 0;
+  std::uint64_t garble_seed = 1;
+};
+
+struct SimOptions {
+  std::string personality = "grbl";  // grbl | xonxoff
+  std::string link_path;             // PTY symlink
+  std::string tcp_address;           // HOST:PORT
+  std::string modbus_address;        // HOST:PORT
+  std::string control_address;       // HOST:PORT
+  std::string log_path;
+  double baud = 115200;
+  double time_scale = 1;
+  MachineConfig machine;
+  GrblParams grbl;
+  XonXoffParams xonxoff;
+  PlcConfig plc;
+  FaultSchedule faults;
+};
+
+// Throws std::runtime_error with the file, line and key for a malformed or unknown entry.
+void apply_machine_file(const std::string& path, SimOptions& options);
+
+}  // namespace lamina::sim

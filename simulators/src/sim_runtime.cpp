@@ -1,0 +1,350 @@
+#include "sim_runtime.hpp"
+
+#include <poll.h>
+#include <sstream>
+#include <stdexcept>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "grbl_protocol.hpp"
+#include "net_util.hpp"
+#include "xonxoff_protocol.hpp"
+
+namespace lamina::sim {
+namespace {
+
+// A late wake-up of up to 20 ms is caught up at once; longer gaps are not (the wire idled).
+constexpr double kBurstS = 0.020;
+
+std::unique_ptr<CncProtocol> make_protocol(const SimOptions& o, Machine& machine) {
+  if (o.personality == "grbl") return make_grbl_protocol(machine, o.grbl);
+  if (o.personality == "xonxoff") return make_xonxoff_protocol(machine, o.xonxoff);
+  throw std::runtime_error(fmt::format("--personality '{}': expected grbl or xonxoff", o.personality));
+}
+
+const char* state_name(MachineState s) {
+  switch (s) {
+    case MachineState::idle: return "idle";
+    case MachineState::run: return "run";
+    case MachineState::hold_pending: return "hold_pending";
+    case MachineState::hold: return "hold";
+    case MachineState::alarm: return "alarm";
+  }
+  return "?";
+}
+
+int state_code(MachineState s) {  // as the PLC's cnc_state register (docs/modbus-map.md)
+  switch (s) {
+    case MachineState::idle: return 0;
+    case MachineState::run: return 1;
+    case MachineState::hold_pending: return 2;
+    case MachineState::hold: return 3;
+    case MachineState::alarm: return 4;
+  }
+  return 0;
+}
+
+}  // namespace
+
+SimRuntime::SimRuntime(SimOptions options)
+    : options_(std::move(options)),
+      start_(std::chrono::steady_clock::now()),
+      machine_(options_.machine),
+      rx_pacer_(options_.baud / 10.0, kBurstS),
+      tx_pacer_(options_.baud / 10.0, kBurstS),
+      log_(options_.log_path),
+      plc_(options_.plc),
+      garble_rng_(options_.faults.garble_seed) {
+  if (!(options_.baud > 0)) throw std::runtime_error("--baud must be positive");
+  if (!(options_.time_scale > 0)) throw std::runtime_error("--time-scale must be positive");
+  protocol_ = make_protocol(options_, machine_);
+  if (!options_.link_path.empty() && !options_.tcp_address.empty())
+    throw std::runtime_error("give --link or --tcp, not both (one serial line per controller)");
+  if (!options_.link_path.empty()) {
+    port_ = open_pty_port(options_.link_path);
+  } else if (!options_.tcp_address.empty()) {
+    const auto [host, port] = parse_loopback_address(options_.tcp_address, "--tcp");
+    port_ = open_tcp_port(host, port);
+  } else {
+    throw std::runtime_error("no CNC port: give --link PATH (a PTY) or --tcp 127.0.0.1:PORT");
+  }
+  if (!options_.modbus_address.empty()) {
+    const auto [host, port] = parse_loopback_address(options_.modbus_address, "--modbus");
+    modbus_ = std::make_unique<ModbusServer>(host, port, plc_, plc_mutex_, [this] { return sim_s(); });
+  }
+  if (!options_.control_address.empty()) {
+    const auto [host, port] = parse_loopback_address(options_.control_address, "--control");
+    control_ = std::make_unique<ControlSocket>(host, port);
+  }
+  // Power-up: the controller prints its banner even before anyone listens (grblHAL does).
+  protocol_->on_connect(0.0);
+  log_.write_event("start", 0.0, {{"personality", options_.personality}, {"port", port_->describe()},
+                                  {"baud", options_.baud}, {"time_scale", options_.time_scale}});
+}
+
+SimRuntime::~SimRuntime() = default;
+
+double SimRuntime::wall_s() const {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+}
+
+nlohmann::json SimRuntime::ready_info() const {
+  nlohmann::json info{{"ready", true}, {"personality", options_.personality}};
+  if (!options_.link_path.empty()) info["link"] = options_.link_path;
+  if (!options_.tcp_address.empty()) info["tcp_port"] = tcp_port_number(*port_);
+  if (modbus_) info["modbus_port"] = modbus_->port();
+  if (control_) info["control_port"] = control_->port();
+  if (!options_.log_path.empty()) info["log"] = options_.log_path;
+  return info;
+}
+
+void SimRuntime::run(const std::atomic<bool>& stop) {
+  while (!stop.load()) {
+    step();
+    std::vector<pollfd> fds;
+    if (int fd = port_->poll_fd(); fd >= 0) fds.push_back({fd, POLLIN, 0});
+    if (control_)
+      for (int fd : control_->poll_fds()) fds.push_back({fd, POLLIN, 0});
+    // 1 ms granularity: a byte at 115200 baud takes 87 µs, so bytes move in small bursts that
+    // the pacer keeps at the right average rate.
+    ::poll(fds.data(), fds.size(), 1);
+  }
+  log_.write_event("stop", sim_s());
+}
+
+void SimRuntime::step() {
+  const double wall = wall_s();
+  const double now = wall * options_.time_scale;
+
+  switch (port_->update()) {
+    case PortChange::client_connected:
+      log_.write_event("connect", now);
+      tx_pending_.clear();
+      protocol_->on_connect(now);
+      break;
+    case PortChange::client_gone:
+      log_.write_event("disconnect", now);
+      break;
+    case PortChange::none: break;
+  }
+  apply_schedule(wall, now);
+  move_bytes_in(wall, now);
+  machine_.advance(now);
+  const bool stalled_by_coil = [&] {
+    std::lock_guard lock(plc_mutex_);
+    return plc_.registers().coils[modbus_map::kCoilSimStall] != 0;
+  }();
+  protocol_->set_stalled(stalled_by_coil || (stall_until_wall_ && wall < *stall_until_wall_));
+  if (stall_until_wall_ && wall >= *stall_until_wall_) {
+    stall_until_wall_.reset();
+    log_.write_event("stall_end", now);
+  }
+  protocol_->poll(now);
+  tick_plc(now);
+  for (const auto& event : machine_.take_events()) log_.write(event);
+  tx_pending_ += protocol_->take_output();
+  move_bytes_out(wall);
+  if (control_) control_->serve([this](const std::string& line) { return handle_command(line); });
+}
+
+void SimRuntime::move_bytes_in(double wall, double now) {
+  std::size_t allowed = rx_pacer_.allowance(wall);
+  if (!port_->client_present()) return;
+  std::uint8_t buffer[4096];
+  std::bernoulli_distribution garble(options_.faults.garble_probability);
+  std::uniform_int_distribution<int> bit(0, 7);
+  while (allowed > 0) {
+    const long n = port_->read_some(buffer, std::min(allowed, sizeof buffer));
+    if (n <= 0) break;
+    rx_pacer_.consume(static_cast<std::size_t>(n));
+    allowed -= static_cast<std::size_t>(n);
+    for (long i = 0; i < n; ++i) {
+      std::uint8_t byte = buffer[i];
+      if (options_.faults.garble_probability > 0 && garble(garble_rng_)) {
+        // Line noise flips a bit: the controller sees another byte, as on a real cable.
+        const std::uint8_t was = byte;
+        byte = static_cast<std::uint8_t>(byte ^ (1u << bit(garble_rng_)));
+        ++bytes_garbled_;
+        log_.write_event("garble", now, {{"from", was}, {"to", byte}});
+      }
+      protocol_->on_byte(byte, now);
+    }
+    // Stop at the line count that unplugs: the bytes after it never reach the controller.
+    if (options_.faults.unplug_at_line && !schedule_unplug_done_ &&
+        protocol_->counters().lines_received >= *options_.faults.unplug_at_line)
+      break;
+  }
+}
+
+void SimRuntime::move_bytes_out(double wall) {
+  std::size_t allowed = tx_pacer_.allowance(wall);
+  if (!port_->client_present()) {
+    tx_pending_.clear();  // nobody on the line: what the controller says is lost
+    return;
+  }
+  while (allowed > 0 && !tx_pending_.empty()) {
+    const std::size_t n = std::min(allowed, tx_pending_.size());
+    const long written = port_->write_some(reinterpret_cast<const std::uint8_t*>(tx_pending_.data()), n);
+    if (written <= 0) break;
+    tx_pacer_.consume(static_cast<std::size_t>(written));
+    allowed -= static_cast<std::size_t>(written);
+    tx_pending_.erase(0, static_cast<std::size_t>(written));
+  }
+}
+
+void SimRuntime::tick_plc(double now) {
+  std::lock_guard lock(plc_mutex_);
+  CncSnapshot snap;
+  snap.state = state_code(machine_.state());
+  snap.executed_blocks = machine_.executed_blocks();
+  const AxisValues pos = machine_.position(now);
+  for (int i = 0; i < kAxisCount; ++i) snap.position[i] = pos[static_cast<std::size_t>(i)];
+  snap.jet_request = machine_.jet_commanded();
+  snap.free_blocks = machine_.free_blocks();
+  plc_.tick(now, snap);
+  // The e-stop chain reaches the CNC too: pressed → ALARM:10 / NAK.
+  if (plc_.estop_pressed() != estop_applied_) {
+    estop_applied_ = plc_.estop_pressed();
+    machine_.set_estop(estop_applied_, now);
+    log_.write_event(estop_applied_ ? "estop" : "estop_released", now);
+  }
+  // Blocks written into the Modbus mailbox go into the same queue as the serial line's.
+  if (const auto block = plc_.pending_block(); block && machine_.has_room()) {
+    if (machine_.submit_line(block->text, now) == GrblStatus::ok)
+      plc_.accept_block(block->seq);
+    else
+      plc_.refuse_block(block->seq);
+  }
+}
+
+void SimRuntime::unplug(double now, const std::string& why) {
+  if (!port_->plugged()) return;
+  port_->unplug();
+  tx_pending_.clear();
+  ++unplugs_;
+  unplugged_by_fault_ = true;
+  log_.write_event("unplug", now, {{"why", why}, {"lines_received", protocol_->counters().lines_received}});
+  if (options_.faults.replug_after_ms) replug_at_wall_ = wall_s() + *options_.faults.replug_after_ms / 1000.0;
+}
+
+void SimRuntime::apply_schedule(double wall, double now) {
+  const auto& f = options_.faults;
+  if (!schedule_unplug_done_ &&
+      ((f.unplug_at_line && protocol_->counters().lines_received >= *f.unplug_at_line) ||
+       (f.unplug_at_s && now >= *f.unplug_at_s))) {
+    schedule_unplug_done_ = true;
+    unplug(now, f.unplug_at_line ? fmt::format("line {}", *f.unplug_at_line) : fmt::format("t {}", *f.unplug_at_s));
+  }
+  if (replug_at_wall_ && wall >= *replug_at_wall_) {
+    replug_at_wall_.reset();
+    port_->replug();
+    log_.write_event("replug", now);
+  }
+  if (!schedule_estop_done_ && f.estop_at_s && now >= *f.estop_at_s) {
+    schedule_estop_done_ = true;
+    std::lock_guard lock(plc_mutex_);
+    plc_.set_estop(true);
+  }
+  if (!schedule_pressure_done_ && f.pressure_drop_at_s && now >= *f.pressure_drop_at_s) {
+    schedule_pressure_done_ = true;
+    std::lock_guard lock(plc_mutex_);
+    plc_.set_pressure_drop(true);
+    log_.write_event("pressure_drop", now);
+  }
+  if (!schedule_stall_done_ && f.stall_at_s && now >= *f.stall_at_s) {
+    schedule_stall_done_ = true;
+    stall_until_wall_ = wall + f.stall_ms / 1000.0;
+    log_.write_event("stall", now, {{"ms", f.stall_ms}});
+  }
+}
+
+nlohmann::json SimRuntime::status_json() const {
+  const double now = sim_s();
+  const auto& c = protocol_->counters();
+  nlohmann::json pos = nlohmann::json::array();
+  for (double v : machine_.position(now)) pos.push_back(v);
+  return {{"t", now},
+          {"state", state_name(machine_.state())},
+          {"position", pos},
+          {"accepted_blocks", machine_.accepted_blocks()},
+          {"executed_blocks", machine_.executed_blocks()},
+          {"queued_blocks", machine_.queued_blocks()},
+          {"starvation", machine_.starvation_count()},
+          {"lines_received", c.lines_received},
+          {"bytes_received", c.bytes_received},
+          {"bytes_dropped", c.bytes_dropped},
+          {"bytes_garbled", bytes_garbled_},
+          {"oks_sent", c.oks_sent},
+          {"oks_dropped", c.oks_dropped},
+          {"errors_sent", c.errors_sent},
+          {"rx_free", protocol_->rx_free()},
+          {"client_present", port_->client_present()},
+          {"plugged", port_->plugged()},
+          {"unplugs", unplugs_},
+          {"jet_commanded", machine_.jet_commanded()}};
+}
+
+std::string SimRuntime::handle_command(const std::string& line) {
+  std::istringstream in(line);
+  std::string verb, arg;
+  in >> verb >> arg;
+  const double now = sim_s();
+  const auto plc_fault = [&](auto&& apply, const char* event) {
+    {
+      std::lock_guard lock(plc_mutex_);
+      apply();
+    }
+    log_.write_event(event, now, {{"source", "control"}});
+    return std::string("ok");
+  };
+  try {
+    if (verb == "status") return status_json().dump();
+    if (verb == "estop" && (arg == "on" || arg == "off"))
+      return plc_fault([&] { plc_.set_estop(arg == "on"); }, arg == "on" ? "estop_request" : "estop_release_request");
+    if (verb == "door" && (arg == "open" || arg == "closed"))
+      return plc_fault([&] { plc_.set_door_open(arg == "open"); }, arg == "open" ? "door_open" : "door_closed");
+    if (verb == "pressure" && (arg == "drop" || arg == "restore"))
+      return plc_fault([&] { plc_.set_pressure_drop(arg == "drop"); },
+                       arg == "drop" ? "pressure_drop" : "pressure_restore");
+    if (verb == "stall") {
+      const double ms = std::stod(arg);
+      if (!(ms > 0)) return "error: stall MS needs a positive number of milliseconds";
+      stall_until_wall_ = wall_s() + ms / 1000.0;
+      log_.write_event("stall", now, {{"ms", ms}, {"source", "control"}});
+      return "ok";
+    }
+    if (verb == "unplug") {
+      unplug(now, "control");
+      return "ok";
+    }
+    if (verb == "replug") {
+      port_->replug();
+      replug_at_wall_.reset();
+      log_.write_event("replug", now, {{"source", "control"}});
+      return "ok";
+    }
+    if (verb == "alarm") {
+      const int code = arg.empty() ? static_cast<int>(GrblAlarm::hard_limit) : std::stoi(arg);
+      machine_.raise_alarm(static_cast<GrblAlarm>(code), now);
+      return "ok";
+    }
+    if (verb == "reset") {  // the operator's reset button on the controller's panel
+      protocol_->external_reset(now);
+      log_.write_event("reset", now, {{"source", "control"}});
+      return "ok";
+    }
+    if (verb == "garble") {
+      const double p = std::stod(arg);
+      if (!(p >= 0 && p <= 1)) return "error: garble P needs a probability in [0, 1]";
+      options_.faults.garble_probability = p;
+      return "ok";
+    }
+  } catch (const std::exception&) {
+    return fmt::format("error: '{}' needs a number, got '{}'", verb, arg);
+  }
+  return fmt::format("error: unknown command '{}' (status, estop on|off, door open|closed, pressure drop|restore, "
+                     "stall MS, unplug, replug, alarm N, reset, garble P)", line);
+}
+
+}  // namespace lamina::sim

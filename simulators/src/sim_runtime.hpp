@@ -1,0 +1,73 @@
+#pragma once
+// The simulator process: one loop that paces bytes between the CNC port and the controller
+// personality, runs the machine's time model, ticks the PLC (whose Modbus server has its own
+// thread), applies scheduled and requested faults, answers the control socket and writes the
+// execution log. Wall time paces the link; simulated time (wall × time scale) runs the machine.
+#include <atomic>
+#include <chrono>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <random>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "byte_pacer.hpp"
+#include "cnc_port.hpp"
+#include "cnc_protocol.hpp"
+#include "control_socket.hpp"
+#include "exec_log.hpp"
+#include "machine.hpp"
+#include "modbus_server.hpp"
+#include "plc.hpp"
+#include "sim_options.hpp"
+
+namespace lamina::sim {
+
+class SimRuntime {
+ public:
+  explicit SimRuntime(SimOptions options);  // opens ports and servers; throws on failure
+  ~SimRuntime();
+
+  // {"ready":true,"personality":…,"link":…,"tcp_port":…,"modbus_port":…,"control_port":…}
+  nlohmann::json ready_info() const;
+  void run(const std::atomic<bool>& stop);
+
+ private:
+  double wall_s() const;
+  double sim_s() const { return wall_s() * options_.time_scale; }
+  void step();
+  void move_bytes_in(double wall, double now);
+  void move_bytes_out(double wall);
+  void tick_plc(double now);
+  void apply_schedule(double wall, double now);
+  void unplug(double now, const std::string& why);
+  std::string handle_command(const std::string& line);
+  nlohmann::json status_json() const;
+
+  SimOptions options_;
+  std::chrono::steady_clock::time_point start_;
+  Machine machine_;
+  std::unique_ptr<CncProtocol> protocol_;
+  std::unique_ptr<CncPort> port_;
+  BytePacer rx_pacer_;
+  BytePacer tx_pacer_;
+  std::string tx_pending_;
+  ExecLog log_;
+  std::mutex plc_mutex_;
+  Plc plc_;
+  std::unique_ptr<ModbusServer> modbus_;
+  std::unique_ptr<ControlSocket> control_;
+  std::mt19937_64 garble_rng_;
+  std::uint64_t bytes_garbled_ = 0;
+  bool estop_applied_ = false;
+  bool unplugged_by_fault_ = false;
+  std::optional<double> replug_at_wall_;
+  std::optional<double> stall_until_wall_;
+  bool schedule_unplug_done_ = false, schedule_estop_done_ = false, schedule_pressure_done_ = false,
+       schedule_stall_done_ = false;
+  std::uint64_t unplugs_ = 0;
+};
+
+}  // namespace lamina::sim
