@@ -200,6 +200,23 @@ class StreamClient {
   bool closed_ = false;
 };
 
+// Run lamina-sim to its exit (for start-up errors): exit status and everything it printed.
+struct SimExit {
+  int status = -1;
+  std::string output;
+};
+inline SimExit run_sim_to_exit(const std::string& args) {
+  SimExit r;
+  const std::string command = std::string("'") + LAMINA_SIM + "' " + args + " 2>&1";
+  FILE* pipe = ::popen(command.c_str(), "r");
+  if (!pipe) return r;
+  char chunk[512];
+  while (std::fgets(chunk, sizeof chunk, pipe)) r.output += chunk;
+  const int status = ::pclose(pipe);
+  r.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
 // One command, one reply line on the simulator's control socket.
 inline std::string control(int port, const std::string& command) {
   StreamClient c = StreamClient::connect_tcp(port);
