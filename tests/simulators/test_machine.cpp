@@ -361,3 +361,80 @@ TEST(Machine, ProgramIsLoggedLineForLine) {
 
 }  // namespace
 }  // namespace lamina::sim
+
+namespace lamina::sim {
+namespace {
+
+TEST(Machine, HoldWhileIdleKeepsLinesQueuedAndDwellClockStops) {
+  Machine m({});
+  m.feed_hold(0);
+  EXPECT_EQ(m.state(), MachineState::hold);
+  ok(m, "G4P2", 1);
+  m.advance(5);
+  EXPECT_EQ(m.executed_blocks(), 0u);  // nothing starts while held
+  m.cycle_start(5);                    // dwell runs 5-7 s
+  m.feed_hold(6);                      // 1 s done: a dwell has nothing to decelerate
+  EXPECT_EQ(m.state(), MachineState::hold);
+  m.cycle_start(10);                   // 1 s left → ends at 11 s
+  EXPECT_FALSE(m.reset(10.5));         // dwelling: no axis moving
+  // The reset cut the dwell short at 10.5 s.
+  const auto b = blocks(m.take_events());
+  ASSERT_EQ(b.size(), 1u);
+  EXPECT_FALSE(b[0].completed);
+  EXPECT_NEAR(b[0].t_start_s, 5, 1e-12);
+  EXPECT_NEAR(b[0].t_end_s, 10.5, 1e-12);
+}
+
+TEST(Machine, DwellResumedAfterHoldEndsOnTime) {
+  Machine m({});
+  ok(m, "G4P2", 0);  // 0-2 s
+  m.feed_hold(0.5);
+  m.cycle_start(3);  // 1.5 s left → 4.5 s
+  m.advance(10);
+  EXPECT_NEAR(blocks(m.take_events()).at(0).t_end_s, 4.5, 1e-9);
+}
+
+TEST(Machine, OnlyMovesAreCheckedAgainstSoftLimits) {
+  MachineConfig config;
+  config.soft_min[0] = 10;  // the machine powers up at X0, outside
+  Machine m(config);
+  ok(m, "(title)", 0);
+  ok(m, "G21G90", 0);
+  ok(m, "G0X20", 0);  // moving back inside is allowed: the target is checked
+  EXPECT_EQ(m.submit_line("G0X5", 1), GrblStatus::soft_limit);
+}
+
+TEST(Machine, ArcBulgingPastALimitIsRefused) {
+  Machine m({});
+  ok(m, "G0X10Y5", 0);
+  // CCW half circle (10,5) → (30,5) around (20,5) goes below through (20,-5): Y < 0.
+  EXPECT_EQ(m.submit_line("G3X30Y5I10J0F600", 1), GrblStatus::soft_limit);
+  MachineConfig config;
+  Machine cw(config);
+  ok(cw, "G0X10Y5", 0);
+  ok(cw, "G2X30Y5I10J0F600", 1);  // the CW one passes above through (20,15): inside
+}
+
+}  // namespace
+}  // namespace lamina::sim
+
+namespace lamina::sim {
+namespace {
+
+TEST(Machine, SameStartAndEndWithIJIsAFullCircle) {
+  Machine m({});
+  ok(m, "G0X10Y10", 0);  // 10 mm at 20000 mm/min: 0.03 s
+  m.advance(1);
+  // Centre (20,10), r = 10: 2π·10 mm at 10 mm/s → 2π s; a quarter of the way clockwise from
+  // the left end (angle π → π/2) is the top, (20, 20).
+  ok(m, "G2X10Y10I10F600", 1);
+  EXPECT_NEAR(m.position(1 + std::numbers::pi / 2)[0], 20, 1e-9);
+  EXPECT_NEAR(m.position(1 + std::numbers::pi / 2)[1], 20, 1e-9);
+  m.advance(20);
+  const auto b = blocks(m.take_events());
+  ASSERT_EQ(b.size(), 2u);
+  EXPECT_NEAR(b[1].t_end_s - b[1].t_start_s, 2 * std::numbers::pi, 1e-9);
+}
+
+}  // namespace
+}  // namespace lamina::sim
