@@ -61,7 +61,9 @@ struct Block {
   std::optional<std::int64_t> line_number;  // N word
   MotionMode motion = MotionMode::none;     // motion in this block (G0/G1/G2/G3 modal or G4)
   std::array<std::optional<double>, kAxisCount> axis_words;  // as written (units of the block)
-  std::optional<double> i_mm, j_mm, k_mm, r_mm;              // arc words, converted to mm
+  // Arc words as written, like the axis words: G20 may come from an earlier line, so the
+  // executor converts them to mm with its modal units (the _mm names are what they become).
+  std::optional<double> i_mm, j_mm, k_mm, r_mm;
   std::optional<double> feed_word;                           // F as written
   std::optional<double> dwell_s;                             // G4 P (seconds, Grbl convention)
   std::optional<bool> set_inches;                            // G20 true / G21 false
@@ -89,6 +91,13 @@ struct ParseResult {
 // E, U, …) → unsupported_command; bad numbers → bad_number_format; a repeated word →
 // word_repeated; two motion commands → modal_group_violation. Checks that need the modal
 // state (feed missing, G93 without F) are the executor's.
+// Further: an unterminated `(` → expected_command_letter; a non-letter where a word starts →
+// expected_command_letter; non-integer G/M → command_value_not_integer; unknown G/M codes →
+// unsupported_command (G17 G40 G49 G54 G80 are accepted no-ops); two codes of one modal
+// group (G20 G21, two jet M-codes…) → modal_group_violation; N negative, fractional or above
+// 10000000 → invalid_line_number; negative F or P → negative_value; G4 without P →
+// value_word_missing; P without G4 → unused_words; G4 with axis words →
+// modal_group_violation; longer than max_line_chars → overflow. T and S are ignored.
 ParseResult parse_block(std::string_view line, const ParseParams& params);
 
 }  // namespace lamina::sim

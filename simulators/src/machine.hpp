@@ -52,6 +52,33 @@ struct AlarmEvent {
 };
 using MachineEvent = std::variant<ExecutedBlock, StarvationEvent, AlarmEvent>;
 
+namespace detail {
+// The planner's modal state (updated when a line is accepted, as Grbl's parser state is).
+struct ModalState {
+  bool relative = false;      // G91
+  bool inches = false;        // G20
+  bool inverse_time = false;  // G93
+  MotionMode motion = MotionMode::rapid;  // Grbl powers up in G0
+  std::optional<double> feed_mm_per_min;  // G94 feed; undefined after G93 → G94 (Grbl)
+};
+
+// One accepted line, planned: absolute start and target, duration, geometry.
+struct PlannedBlock {
+  std::uint64_t seq = 0;
+  std::string line;
+  std::optional<std::int64_t> line_number;
+  double submit_s = 0;
+  MotionMode kind = MotionMode::none;  // none: zero-time block (modal, comment, M-code)
+  AxisValues start{}, target{};
+  double duration_s = 0;
+  double path_length = 0;       // mm (deg for a rotary-only move); hold deceleration runs on it
+  double feed_mm_per_min = 0;   // effective feed reported while it runs
+  double center_x = 0, center_y = 0, radius = 0, start_angle = 0, sweep = 0;  // arcs (rad)
+  std::optional<bool> jet_on;
+  bool program_end = false;
+};
+}  // namespace detail
+
 class Machine {
  public:
   explicit Machine(MachineConfig config);
@@ -93,8 +120,41 @@ class Machine {
   std::vector<MachineEvent> take_events();
 
  private:
+  // The running block's progress is a path fraction s ∈ [0, 1]: cruising at constant speed,
+  // decelerating for a feed hold, or stopped (held).
+  enum class Phase { cruise, decel, stopped };
+  struct Running {
+    detail::PlannedBlock block;
+    double t_start_s = 0;
+    Phase phase = Phase::cruise;
+    double seg_t0_s = 0, seg_s0 = 0;          // the current phase began at (time, fraction)
+    double decel_v = 0;                       // path units/s when the deceleration began
+    double decel_tau_s = 0, decel_s_end = 0;  // deceleration length in time, fraction at its end
+  };
+
+  double fraction_at(const Running& r, double now_s) const;
+  double phase_end_s(const Running& r) const;
+  void start_next(double t_s);
+  void finish_running(double t_s);
+  void stop_running(double t_s);  // cut the running block short (reset, alarm)
+  void alarm_stop(GrblAlarm code, double t_s, std::uint64_t seq);
+  void reset_modal();
+
   MachineConfig config_;
-  // (implementation state: modal state, the queue, the running block, counters)
+  detail::ModalState modal_;
+  AxisValues planned_pos_{};  // where the last queued block ends
+  AxisValues pos_{};          // machine position when no block is running
+  std::deque<detail::PlannedBlock> queue_;
+  std::optional<Running> running_;
+  double last_end_s_ = 0;     // the next block starts no earlier than this
+  bool held_ = false;         // feed hold requested and not resumed
+  std::optional<GrblAlarm> alarm_;
+  bool estop_ = false;
+  bool jet_ = false;
+  bool program_running_ = false;
+  bool starved_ = false;      // starvation already reported for this empty period
+  std::uint64_t accepted_ = 0, executed_ = 0, starvations_ = 0;
+  std::vector<MachineEvent> events_;
 };
 
 }  // namespace lamina::sim

@@ -1,0 +1,297 @@
+// The simulated CNC's executor: queue, modal state, feed hold, alarms, events.
+//
+// Behaviour where the header leaves room (all Grbl-like unless said):
+// - The running block keeps its planner slot until it finishes (Grbl frees a block when it is
+//   done), so queued_blocks() and the capacity count it.
+// - A block starts when the previous one ended, or at its submit time if the queue had run dry,
+//   or at the cycle-start time after a hold.
+// - Feed hold in Idle enters Hold at once (Grbl 1.1 too); lines sent then wait for `~`. A hold
+//   during a dwell stops the dwell clock at once (no motion to decelerate). Cycle start while
+//   still decelerating is ignored, as in Grbl (hold must be complete).
+// - Modal changes (G20, G91, F…) act when the line is accepted, like Grbl's parser state; the
+//   jet M-codes and M2/M30 act when their block starts executing.
+// - M2/M30 (Grbl's program end): G1, G90, G94 and jet off; units and F stay (Grbl keeps them).
+// - reset() returns true only when an axis was moving (cruising or decelerating), not during a
+//   dwell or a completed hold.
+// - Soft-limit alarms report the seq the refused line would have had (accepted_blocks() + 1),
+//   which is its program line when a sender streams a program line for line.
+// - submit_line without room is refused with overflow (a caller bug; nothing is queued).
+#include "machine.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "machine_plan.hpp"
+
+namespace lamina::sim {
+
+Machine::Machine(MachineConfig config) : config_(std::move(config)) {}
+
+GrblStatus Machine::submit_line(std::string_view line, double now_s) {
+  advance(now_s);
+  if (alarm_) return GrblStatus::system_gc_lock;
+  const ParseResult parsed = parse_block(line, config_.parse);
+  if (parsed.status != GrblStatus::ok) return parsed.status;
+  if (parsed.block.percent) return GrblStatus::ok;
+  if (!has_room()) return GrblStatus::overflow;
+
+  detail::ModalState modal = modal_;
+  detail::PlannedBlock planned;
+  if (const GrblStatus s = detail::plan_block(parsed.block, modal, planned_pos_, config_, planned);
+      s != GrblStatus::ok)
+    return s;
+  if (config_.soft_limits && !detail::within_soft_limits(planned, config_)) {
+    alarm_stop(GrblAlarm::soft_limit, now_s, accepted_ + 1);
+    return GrblStatus::soft_limit;
+  }
+  if (planned.program_end) {
+    // Grbl's program end resets these in the parser state as the line is read.
+    modal.motion = MotionMode::linear;
+    modal.relative = false;
+    if (modal.inverse_time) modal.feed_mm_per_min.reset();
+    modal.inverse_time = false;
+  }
+  modal_ = modal;
+  planned.seq = ++accepted_;
+  planned.line = std::string(line);
+  planned.submit_s = now_s;
+  planned_pos_ = planned.target;
+  program_running_ = true;  // from the first block after Idle until M2/M30 executes
+  starved_ = false;
+  queue_.push_back(std::move(planned));
+  advance(now_s);
+  return GrblStatus::ok;
+}
+
+bool Machine::has_room() const { return free_blocks() > 0; }
+std::size_t Machine::free_blocks() const {
+  return config_.planner_blocks > queued_blocks() ? config_.planner_blocks - queued_blocks() : 0;
+}
+std::size_t Machine::queued_blocks() const { return queue_.size() + (running_ ? 1 : 0); }
+
+double Machine::fraction_at(const Running& r, double now_s) const {
+  const double dt = std::max(0.0, now_s - r.seg_t0_s);
+  switch (r.phase) {
+    case Phase::cruise:
+      if (r.block.duration_s <= 0) return 1;
+      return std::min(1.0, r.seg_s0 + dt / r.block.duration_s);
+    case Phase::decel: {
+      const double tau = std::min(dt, r.decel_tau_s);
+      const double a = config_.hold_decel_mm_per_s2;
+      return std::min(r.decel_s_end, r.seg_s0 + (r.decel_v * tau - a * tau * tau / 2) / r.block.path_length);
+    }
+    case Phase::stopped: return r.seg_s0;
+  }
+  return r.seg_s0;
+}
+
+// When the current phase ends (cruise: block done; decel: stopped or block done). Stopped: never.
+double Machine::phase_end_s(const Running& r) const {
+  switch (r.phase) {
+    case Phase::cruise: return r.seg_t0_s + (1 - r.seg_s0) * r.block.duration_s;
+    case Phase::decel: return r.seg_t0_s + r.decel_tau_s;
+    case Phase::stopped: break;
+  }
+  return INFINITY;
+}
+
+void Machine::advance(double now_s) {
+  while (!alarm_) {
+    if (!running_) {
+      if (held_ || queue_.empty()) return;
+      start_next(std::max(last_end_s_, queue_.front().submit_s));
+      continue;
+    }
+    Running& r = *running_;
+    const double end_s = phase_end_s(r);
+    if (end_s > now_s) return;
+    if (r.phase == Phase::decel && r.decel_s_end < 1) {
+      r.phase = Phase::stopped;  // hold complete part-way through the block
+      r.seg_t0_s = end_s;
+      r.seg_s0 = r.decel_s_end;
+      return;
+    }
+    finish_running(end_s);
+  }
+}
+
+void Machine::start_next(double t_s) {
+  Running r;
+  r.block = std::move(queue_.front());
+  queue_.pop_front();
+  r.t_start_s = t_s;
+  r.seg_t0_s = t_s;
+  if (config_.alarm_at_seq && r.block.seq == *config_.alarm_at_seq) {
+    // Fault injection: the block never moves; it is logged cut short, then the alarm stops all.
+    const std::uint64_t seq = r.block.seq;
+    r.block.target = pos_;
+    r.block.start = pos_;
+    r.block.duration_s = 0;
+    running_ = std::move(r);
+    alarm_stop(config_.alarm_at_seq_code, t_s, seq);
+    return;
+  }
+  if (r.block.jet_on) jet_ = *r.block.jet_on;
+  if (r.block.program_end) {
+    jet_ = false;
+    program_running_ = !queue_.empty();  // lines already queued behind M2 start the next program
+  }
+  running_ = std::move(r);
+}
+
+void Machine::finish_running(double t_s) {
+  const detail::PlannedBlock& b = running_->block;
+  const std::uint64_t seq = b.seq;
+  events_.push_back(ExecutedBlock{b.seq, b.line, b.start, b.target, jet_, running_->t_start_s, t_s, true});
+  pos_ = b.target;
+  last_end_s_ = t_s;
+  ++executed_;
+  running_.reset();
+  if (queue_.empty() && program_running_ && !held_ && !alarm_ && !starved_) {
+    events_.push_back(StarvationEvent{t_s, seq});
+    starved_ = true;
+    ++starvations_;
+  }
+}
+
+void Machine::stop_running(double t_s) {
+  if (!running_) return;
+  const detail::PlannedBlock& b = running_->block;
+  pos_ = detail::interpolate(b, fraction_at(*running_, t_s));
+  events_.push_back(ExecutedBlock{b.seq, b.line, b.start, pos_, jet_, running_->t_start_s, t_s, false});
+  ++executed_;
+  running_.reset();
+}
+
+void Machine::reset_modal() {
+  modal_ = detail::ModalState{};
+  jet_ = false;
+  held_ = false;
+  program_running_ = false;
+  starved_ = false;
+}
+
+void Machine::alarm_stop(GrblAlarm code, double t_s, std::uint64_t seq) {
+  stop_running(t_s);
+  queue_.clear();
+  planned_pos_ = pos_;
+  last_end_s_ = t_s;
+  reset_modal();
+  alarm_ = code;
+  events_.push_back(AlarmEvent{t_s, code, seq});
+}
+
+void Machine::feed_hold(double now_s) {
+  advance(now_s);
+  if (alarm_ || held_) return;
+  held_ = true;
+  if (!running_) return;  // Idle (or between blocks): Hold at once
+  Running& r = *running_;
+  const double s = fraction_at(r, now_s);
+  r.seg_t0_s = now_s;
+  r.seg_s0 = s;
+  if (r.block.kind == MotionMode::dwell || r.block.path_length <= 0) {
+    r.phase = Phase::stopped;
+    return;
+  }
+  // Decelerate from the block's speed: v²/2a to stop, or what is left of the block if less
+  // (then the block ends still moving, and the hold completes there).
+  const double v = r.block.path_length / r.block.duration_s;
+  const double a = config_.hold_decel_mm_per_s2;
+  const double left = (1 - s) * r.block.path_length;
+  const double stop = v * v / (2 * a);
+  r.phase = Phase::decel;
+  r.decel_v = v;
+  if (stop < left) {
+    r.decel_tau_s = v / a;
+    r.decel_s_end = s + stop / r.block.path_length;
+  } else {
+    r.decel_tau_s = (v - std::sqrt(std::max(0.0, v * v - 2 * a * left))) / a;
+    r.decel_s_end = 1;
+  }
+  advance(now_s);
+}
+
+void Machine::cycle_start(double now_s) {
+  advance(now_s);
+  if (alarm_ || !held_) return;
+  if (running_ && running_->phase == Phase::decel) return;  // hold not complete yet
+  held_ = false;
+  if (running_) {
+    running_->phase = Phase::cruise;
+    running_->seg_t0_s = now_s;
+  } else {
+    last_end_s_ = std::max(last_end_s_, now_s);
+    if (queue_.empty() && program_running_ && !starved_) {
+      // Resumed with nothing to run: the program is starving from now.
+      events_.push_back(StarvationEvent{now_s, accepted_});
+      starved_ = true;
+      ++starvations_;
+    }
+  }
+  advance(now_s);
+}
+
+bool Machine::reset(double now_s) {
+  advance(now_s);
+  const bool moving = running_ && running_->block.kind != MotionMode::dwell &&
+                      running_->block.path_length > 0 && running_->phase != Phase::stopped;
+  stop_running(now_s);
+  queue_.clear();
+  planned_pos_ = pos_;
+  last_end_s_ = now_s;
+  reset_modal();  // an alarm stays latched: it needs $X (or the e-stop released and $X)
+  return moving;
+}
+
+void Machine::raise_alarm(GrblAlarm code, double now_s) {
+  advance(now_s);
+  alarm_stop(code, now_s, running_ ? running_->block.seq : 0);
+}
+
+bool Machine::unlock() {
+  if (estop_) return false;
+  alarm_.reset();
+  return true;
+}
+
+void Machine::set_estop(bool pressed, double now_s) {
+  if (pressed && !estop_) raise_alarm(GrblAlarm::estop, now_s);
+  estop_ = pressed;
+}
+
+MachineState Machine::state() const {
+  if (alarm_) return MachineState::alarm;
+  if (held_) return running_ && running_->phase == Phase::decel ? MachineState::hold_pending : MachineState::hold;
+  if (running_ || !queue_.empty()) return MachineState::run;
+  return MachineState::idle;
+}
+
+AxisValues Machine::position(double now_s) const {
+  if (!running_) return pos_;
+  return detail::interpolate(running_->block, fraction_at(*running_, now_s));
+}
+
+double Machine::feed_mm_per_min(double now_s) const {
+  if (!running_ || running_->phase == Phase::stopped || fraction_at(*running_, now_s) >= 1) return 0;
+  return running_->block.feed_mm_per_min;
+}
+
+std::optional<std::int64_t> Machine::line_number() const {
+  if (!running_) return std::nullopt;
+  return running_->block.line_number;
+}
+
+std::uint64_t Machine::accepted_blocks() const { return accepted_; }
+std::uint64_t Machine::executed_blocks() const { return executed_; }
+std::uint64_t Machine::starvation_count() const { return starvations_; }
+bool Machine::jet_commanded() const { return jet_; }
+std::optional<GrblAlarm> Machine::alarm() const { return alarm_; }
+
+std::vector<MachineEvent> Machine::take_events() {
+  std::vector<MachineEvent> out;
+  out.swap(events_);
+  return out;
+}
+
+}  // namespace lamina::sim
