@@ -50,7 +50,7 @@ TEST(XonXoffProtocol, ConnectSaysReadyWithDc1) {
 TEST(XonXoffProtocol, ProgramRunsLineForLineAndLeaderIsIgnored) {
   XonXoff x;
   x.send("G0 X500\r\n");  // before the first %: tape leader, ignored
-  const std::vector<std::string> program{"O1000 (DEMO)", "G21 G90", "G1 X10 F600", "", "G1 Y5", "M30"};
+  const std::vector<std::string> program{"(O1000 DEMO)", "G21 G90", "G1 X10 F600", "", "G1 Y5", "M30"};
   std::string text = "%\r\n";
   for (const auto& line : program) text += line + "\r\n";
   text += "%";
@@ -87,7 +87,9 @@ TEST(XonXoffProtocol, Dc1WaitsUntilTheMachineDrainsTheBuffer) {
   MachineConfig config;
   config.planner_blocks = 2;
   XonXoff x(small_buffer(), config);
-  x.send("%\n" + blocks(20));  // 1 s per block, the planner takes only 2 at a time
+  std::string slow;  // 10 bytes and 1 s (1 mm at 60 mm/min) per block
+  for (int i = 0; i < 22; ++i) slow += (i % 2 == 0) ? "G1 X1 F60\n" : "G1 X2 F60\n";
+  x.send("%\n" + slow);  // the planner takes only 2 at a time
   EXPECT_EQ(count_of(x.take(), kDc3), 1);
   x.run_for(3.0);
   EXPECT_EQ(x.take(), "");  // still above low water
