@@ -2,9 +2,12 @@
 // Drives a CncProtocol and a real Machine with a simulated clock, the way the process loop
 // does: bytes one at a time, then machine.advance + protocol.poll. Output is collected so a
 // test can look at everything the controller said since the last `take()`.
+#include <algorithm>
 #include <memory>
 #include <string>
 #include <string_view>
+#include <utility>
+#include <variant>
 #include <vector>
 
 #include "cnc_protocol.hpp"

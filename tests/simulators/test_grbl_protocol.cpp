@@ -233,6 +233,9 @@ TEST(GrblProtocol, ReceiveBufferOverflowLosesBytes) {
   EXPECT_EQ(g.protocol->rx_free(), 0u);
   EXPECT_EQ(g.protocol->counters().bytes_received, 128u);
   EXPECT_EQ(g.protocol->counters().bytes_dropped, burst.size() - 128);
+  // Real-time bytes still work with the buffer full: they never enter it.
+  g.send_burst("?");
+  EXPECT_EQ(parse_status(g.protocol->take_output()).bf_rx, 0);
   g.tick();
   // 11 whole lines fit in 128 bytes; the 12th is cut and joins what comes next.
   EXPECT_EQ(count_of(g.take(), "ok"), 11);
@@ -304,6 +307,34 @@ TEST(GrblProtocol, BuildInfoCarriesPlannerRxAndAxes) {
   EXPECT_NE(out.find("[OPT:VNL,7,256,5,0]\r\n"), std::string::npos) << out;
   EXPECT_NE(out.find("[AXS:5:XYZAC]\r\n"), std::string::npos) << out;
   EXPECT_TRUE(out.ends_with("]\r\nok\r\n")) << out;
+}
+
+TEST(GrblProtocol, ExtendedRealTimeBytesAndTopBitBytesStayOutOfTheBuffer) {
+  Grbl g;
+  g.send("G1 X100 F6000\n");
+  g.run_for(0.2);
+  g.take();
+  g.send("\x84\xA5\xFF\x07");  // safety door (no door here), unknown, bell: all dropped
+  EXPECT_EQ(g.protocol->rx_free(), 1024u);
+  EXPECT_EQ(g.protocol->counters().bytes_received, 14u);
+  g.send("\x82");  // grblHAL's feed hold
+  g.send("\x80");  // grblHAL's status report
+  EXPECT_EQ(parse_status(g.take()).state, "Hold:1");
+  g.run_for(1.0);
+  g.send("\x81");  // grblHAL's cycle start
+  g.run_for(0.1);
+  EXPECT_EQ(parse_status(g.status()).state, "Run");
+}
+
+TEST(GrblProtocol, ParserStateShowsTheAcceptedModes) {
+  Grbl g;
+  g.send("$G\n");
+  EXPECT_EQ(g.take(), "[GC:G0 G54 G17 G21 G90 G94 M5 M9 T0 F0 S0]\r\nok\r\n");
+  g.send("G20 G91 G1 X0.1 F12\n$G\n");
+  EXPECT_EQ(g.take(), "ok\r\n[GC:G1 G54 G17 G20 G91 G94 M5 M9 T0 F12 S0]\r\nok\r\n");
+  g.run_for(1.0);  // 0.1 in at 12 in/min: done after 0.5 s, so the reset is not an abort
+  g.send("\x18$G\n");  // reset: defaults again
+  EXPECT_EQ(g.take(), kBanner + "[GC:G0 G54 G17 G21 G90 G94 M5 M9 T0 F0 S0]\r\nok\r\n");
 }
 
 TEST(GrblProtocol, OverlongLineIsErrorEleven) {

@@ -160,5 +160,23 @@ TEST(XonXoffProtocol, ResetAfterAlarmClearsItAndSaysReady) {
   EXPECT_EQ(x.executed_lines().back(), "G0 X1");
 }
 
+TEST(XonXoffProtocol, EstopHaltsAndResetWaitsForItsRelease) {
+  XonXoff x;
+  x.send("%\nG1 X100 F600\n");
+  x.run_for(0.2);
+  x.machine.set_estop(true, x.now_s);
+  x.tick();
+  EXPECT_EQ(x.take(), kDc3 + kNak);
+  x.protocol->external_reset(x.now_s);  // e-stop still pressed: no DC1
+  x.run_for(0.5);
+  EXPECT_EQ(x.take(), kDc3 + kSyn);
+  EXPECT_TRUE(x.machine.alarm().has_value());
+  x.machine.set_estop(false, x.now_s);
+  x.protocol->external_reset(x.now_s);
+  x.tick();
+  EXPECT_EQ(x.take(), kDc3 + kSyn + kDc1);
+  EXPECT_FALSE(x.machine.alarm().has_value());
+}
+
 }  // namespace
 }  // namespace lamina::sim
