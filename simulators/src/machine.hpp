@@ -89,6 +89,8 @@ class Machine {
   // A target outside the soft limits raises ALARM:2 (queue flushed, motion stopped) and
   // returns soft_limit. In alarm every line is refused with system_gc_lock.
   GrblStatus submit_line(std::string_view line, double now_s);
+  // Capacity is planner_blocks; the running block keeps its slot until it finishes (Grbl).
+  // Submitting without room is refused with overflow and queues nothing.
   bool has_room() const;
   std::size_t free_blocks() const;
   std::size_t queued_blocks() const;
@@ -107,8 +109,12 @@ class Machine {
   void set_estop(bool pressed, double now_s);      // pressed → ALARM:10, unlock refused
 
   MachineState state() const;
-  AxisValues position(double now_s) const;         // interpolated within the running block
-  double feed_mm_per_min(double now_s) const;      // current programmed feed while moving
+  // Interpolated within the running block as of the last advance (call advance(now_s) first
+  // for an exact answer; it does not start the next block itself).
+  AxisValues position(double now_s) const;
+  // Feed of the running move (0 when not moving): the effective path speed, so rapids and G93
+  // moves report mm/min too (°/min for a rotary-only move).
+  double feed_mm_per_min(double now_s) const;
   std::optional<std::int64_t> line_number() const; // N of the running block, if any
   std::uint64_t accepted_blocks() const;           // seq of the last accepted block
   std::uint64_t executed_blocks() const;           // blocks finished

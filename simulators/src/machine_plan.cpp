@@ -3,7 +3,8 @@
 //   G1/G2/G3 in G94: path length / feed, the feed clamped to max_feed. The path length is the
 //     XYZ distance in mm when a linear axis moves, else the A/C distance in degrees (Grbl and
 //     LinuxCNC both time a rotary-only move by its degrees).
-//   G1/G2/G3 in G93: 1/F minutes; F must be on the line (RS274NGC, Grbl).
+//   G1/G2/G3 in G93: 1/F minutes; F must be on the line (RS274NGC, Grbl). G0 in G93 needs no
+//     F here (Grbl 1.1 asks for one through a known bug; our posts never send G0 in G93).
 //   Any feed move also takes at least its rapid time: no axis runs faster than its rapid rate.
 //   G4: P seconds. Everything else: zero time.
 // Arcs run in the XY plane (G17, the only plane here) with I/J centre offsets (relative to the
@@ -166,6 +167,9 @@ AxisValues interpolate(const PlannedBlock& b, double s) {
 }
 
 bool within_soft_limits(const PlannedBlock& b, const MachineConfig& config) {
+  // Only moves are checked: a comment or M-code must not alarm a machine that powered up
+  // outside its limits (it may still move back in).
+  if (b.kind == MotionMode::none || b.kind == MotionMode::dwell) return true;
   auto inside = [&config](const AxisValues& p) {
     for (int i = 0; i < kAxisCount; ++i)
       if (p[i] < config.soft_min[i] || p[i] > config.soft_max[i]) return false;
