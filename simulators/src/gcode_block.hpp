@@ -43,6 +43,9 @@ enum class GrblAlarm : int {
   soft_limit = 2,
   abort_cycle = 3,  // reset while moving: position may be lost
   estop = 10,
+  // Simulator-specific codes of the xonxoff (Fanuc drip-feed) personality, outside grbl's range:
+  program_error = 80,    // a block the parser / executor refused: a Fanuc stops with an alarm
+  buffer_overflow = 87,  // bytes beyond the margin after DC3 (Fanuc's PS087 BUFFER OVERFLOW)
 };
 
 inline constexpr int kAxisCount = 5;  // X Y Z A C

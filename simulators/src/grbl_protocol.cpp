@@ -1,0 +1,251 @@
+// grblHAL-like line protocol (see grbl_protocol.hpp). Behaviour follows grblHAL/core
+// protocol.c (line assembly, real-time byte filter, the error lock) and report.c (formats,
+// in grbl_reports.cpp). Deliberate simplifications are marked "Simplification:".
+#include "grbl_protocol.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <deque>
+#include <utility>
+
+#include <fmt/format.h>
+
+#include "grbl_reports.hpp"
+
+namespace lamina::sim {
+namespace {
+
+// grblHAL's Status_EStop: `$X` refused while the e-stop input is still active. Not in
+// GrblStatus because only the protocol answers it.
+constexpr int kStatusEStop = 50;
+
+constexpr std::uint8_t kReset = 0x18;            // ctrl-X
+constexpr std::uint8_t kStatusReport = 0x80;     // grblHAL's extended aliases of ? ~ !
+constexpr std::uint8_t kCycleStart = 0x81;
+constexpr std::uint8_t kFeedHold = 0x82;
+constexpr std::uint8_t kStatusReportAll = 0x87;
+
+class GrblProtocol final : public CncProtocol {
+ public:
+  // The planner size for $I is read while the machine is fresh (Machine does not expose its
+  // configuration): free + queued is the capacity whenever no block is running.
+  GrblProtocol(Machine& machine, GrblParams params)
+      : machine_(machine), params_(params),
+        planner_blocks_(machine.free_blocks() + machine.queued_blocks()) {}
+
+  void on_connect(double /*now_s*/) override {
+    out_ += grbl::banner();
+    if (machine_.alarm()) out_ += fmt::format("[MSG:'$H'|'$X' to unlock]{}", grbl::kEol);
+  }
+
+  void on_byte(std::uint8_t byte, double now_s) override {
+    // Real-time bytes are picked off the stream on arrival (grblHAL does it in the UART
+    // interrupt), so they work even when the receive buffer is full and never take a place
+    // in it. grblHAL keeps legacy ? ! ~ real-time by default ($-setting RT+).
+    switch (byte) {
+      case kReset: soft_reset(now_s); return;
+      case '?':
+      case kStatusReport:
+      case kStatusReportAll:
+        machine_.advance(now_s);  // report the state as of this instant
+        out_ += grbl::status_report(machine_, rx_free(), now_s);
+        return;
+      case '!':
+      case kFeedHold: machine_.feed_hold(now_s); return;
+      case '~':
+      case kCycleStart: machine_.cycle_start(now_s); return;
+      case '\n':
+      case '\r': break;
+      default:
+        // grblHAL drops other control characters, DEL and every top-bit byte it has no
+        // handler for (0x84 safety door included: the simulator has no door state).
+        if (byte < 0x20 || byte >= 0x7F) return;
+    }
+    if (rx_.size() >= params_.rx_buffer_bytes) {
+      ++counters_.bytes_dropped;  // a full UART ring: the byte is lost, as on hardware
+      return;
+    }
+    rx_.push_back(static_cast<char>(byte));
+    ++counters_.bytes_received;
+  }
+
+  void poll(double now_s) override {
+    report_alarm_change();
+    while (!stalled_) {
+      if (!take_line(now_s)) break;
+      report_alarm_change();
+    }
+  }
+
+  std::string take_output() override { return std::exchange(out_, {}); }
+  void set_stalled(bool stalled) override { stalled_ = stalled; }
+  void external_reset(double now_s) override { soft_reset(now_s); }
+  std::size_t rx_free() const override { return params_.rx_buffer_bytes - rx_.size(); }
+  const ProtocolCounters& counters() const override { return counters_; }
+
+ private:
+  // Takes and answers one complete line. False when there is none, or the machine has no
+  // room for it (the line waits in the receive buffer: that back-pressure is what a
+  // character-counting sender sees in the missing `ok`).
+  bool take_line(double now_s) {
+    const auto eol_it = std::find_if(rx_.begin(), rx_.end(), [](char c) { return c == '\n' || c == '\r'; });
+    if (eol_it == rx_.end()) return false;
+    const char eol = *eol_it;
+    const auto raw_len = static_cast<std::size_t>(eol_it - rx_.begin());
+
+    // CR LF (or LF CR) is one end of line: the second one ends an empty line, which grblHAL
+    // swallows instead of answering a second `ok`.
+    if (raw_len == 0 && last_eol_ != 0 && last_eol_ != eol) {
+      rx_.pop_front();
+      last_eol_ = 0;
+      return true;
+    }
+
+    // grblHAL strips leading whitespace and control characters while assembling the line.
+    std::string line;
+    bool overflow = false;
+    for (auto it = rx_.begin(); it != eol_it; ++it) {
+      const char c = *it;
+      if (line.empty() && c == ' ') continue;
+      if (line.size() >= kLineBufferChars) {
+        overflow = true;
+        continue;
+      }
+      line += c;
+    }
+
+    const bool is_gcode = !overflow && !line.empty() && line.front() != '$';
+    const bool locked = is_gcode && (machine_.state() == MachineState::alarm || last_error_ != 0);
+    if (is_gcode && !locked && !machine_.has_room()) return false;
+
+    rx_.erase(rx_.begin(), std::next(eol_it));
+    last_eol_ = eol;
+    ++counters_.lines_received;
+
+    if (overflow) {
+      answer(static_cast<int>(GrblStatus::overflow));
+    } else if (line.empty()) {
+      answer(0);  // the sync line: also clears the error lock
+    } else if (line.front() == '$') {
+      answer(system_command(line));
+    } else if (machine_.state() == MachineState::alarm) {
+      answer(static_cast<int>(GrblStatus::system_gc_lock));
+    } else if (last_error_ != 0) {
+      // The error lock (grblHAL, compatibility level 0): after an error the following G-code
+      // lines are not executed and answered with the same error again, so a streaming
+      // sender cannot run the rest of a program whose earlier line failed.
+      answer(last_error_);
+    } else {
+      const GrblStatus status = machine_.submit_line(line, now_s);
+      if (status == GrblStatus::ok) track_modal(line);
+      report_alarm_change();  // a soft-limit target: ALARM:2 first, then the line's error:10
+      answer(static_cast<int>(status));
+    }
+    return true;
+  }
+
+  // `ok`, or `error:N`; every answer also sets grblHAL's gc_state.last_error.
+  void answer(int status) {
+    last_error_ = status;
+    if (status != 0) {
+      out_ += fmt::format("error:{}{}", status, grbl::kEol);
+      ++counters_.errors_sent;
+      return;
+    }
+    ++ok_index_;
+    if (params_.faults.drop_ok_index && *params_.faults.drop_ok_index == ok_index_) {
+      ++counters_.oks_dropped;  // fault: this `ok` is lost on the wire
+      return;
+    }
+    out_ += fmt::format("ok{}", grbl::kEol);
+    ++counters_.oks_sent;
+  }
+
+  int system_command(const std::string& line) {
+    std::string cmd = line;
+    std::transform(cmd.begin(), cmd.end(), cmd.begin(), [](unsigned char c) { return std::toupper(c); });
+    std::erase(cmd, ' ');
+    if (cmd == "$") {
+      out_ += grbl::help();
+    } else if (cmd == "$I") {
+      out_ += grbl::build_info(planner_blocks_, params_.rx_buffer_bytes);
+    } else if (cmd == "$G") {
+      out_ += grbl::parser_state(modal_, machine_.jet_commanded());
+    } else if (cmd == "$$") {
+      out_ += grbl::settings_dump();
+    } else if (cmd == "$X") {
+      if (machine_.state() == MachineState::alarm) {
+        if (!machine_.unlock()) return kStatusEStop;
+        out_ += fmt::format("[MSG:Caution: Unlocked]{}", grbl::kEol);
+        reported_alarm_.reset();
+      }
+      // Outside an alarm $X has no effect, and answers ok.
+    } else {
+      return static_cast<int>(GrblStatus::invalid_statement);
+    }
+    return 0;
+  }
+
+  // Soft reset (0x18, or the operator's reset): motion stops, the planner queue and the
+  // receive buffer are flushed, the error lock clears and the banner is sent again. Reset
+  // while moving loses position: grbl raises ALARM:3 and stays in alarm until $X.
+  void soft_reset(double now_s) {
+    const bool was_moving = machine_.reset(now_s);
+    if (was_moving) machine_.raise_alarm(GrblAlarm::abort_cycle, now_s);
+    report_alarm_change();  // ALARM:3 comes before the banner, as grblHAL prints it
+    rx_.clear();
+    last_eol_ = 0;
+    last_error_ = 0;
+    modal_ = {};
+    on_connect(now_s);
+  }
+
+  // Alarms are watched through the machine's state rather than its events (the process loop
+  // consumes those for the log). Each alarm is announced once; clearing it re-arms.
+  void report_alarm_change() {
+    const auto alarm = machine_.alarm();
+    if (!alarm) {
+      reported_alarm_.reset();
+      return;
+    }
+    if (reported_alarm_ == alarm) return;
+    reported_alarm_ = alarm;
+    out_ += fmt::format("ALARM:{}{}", static_cast<int>(*alarm), grbl::kEol);
+  }
+
+  // Keeps what `$G` shows; parse_block is the same parser the machine uses.
+  void track_modal(const std::string& line) {
+    const ParseResult parsed = parse_block(line, ParseParams{});
+    if (parsed.status != GrblStatus::ok) return;
+    const Block& b = parsed.block;
+    if (b.motion != MotionMode::none && b.motion != MotionMode::dwell) modal_.motion = b.motion;
+    if (b.set_inches) modal_.inches = *b.set_inches;
+    if (b.set_relative) modal_.relative = *b.set_relative;
+    if (b.set_inverse_time) modal_.inverse_time = *b.set_inverse_time;
+    if (b.feed_word) modal_.feed = *b.feed_word;
+  }
+
+  // grblHAL's LINE_BUFFER_SIZE is 257 with the terminator: longer lines answer error:11.
+  static constexpr std::size_t kLineBufferChars = 256;
+
+  Machine& machine_;
+  GrblParams params_;
+  std::size_t planner_blocks_;
+  std::deque<char> rx_;  // the receive ring: bytes not yet taken as lines
+  std::string out_;
+  ProtocolCounters counters_;
+  bool stalled_ = false;
+  char last_eol_ = 0;
+  int last_error_ = 0;
+  std::uint64_t ok_index_ = 0;
+  std::optional<GrblAlarm> reported_alarm_;
+  grbl::ModalView modal_;
+};
+
+}  // namespace
+
+std::unique_ptr<CncProtocol> make_grbl_protocol(Machine& machine, GrblParams params) {
+  return std::make_unique<GrblProtocol>(machine, params);
+}
+
+}  // namespace lamina::sim
