@@ -5,7 +5,6 @@
 #include <cctype>
 #include <fstream>
 #include <map>
-#include <optional>
 #include <regex>
 #include <set>
 #include <sstream>
@@ -104,21 +103,25 @@ DocTables parse_doc(const std::string& text) {
       {"## Alarm codes", Table::alarm}};
   const std::regex row(R"(^\|\s*(\d+)\s*\|\s*([a-z0-9_]+)\s*\|)");
   DocTables tables;
-  std::optional<Table> current;
+  Table current = Table::coil;
+  bool in_table = false;  // (not std::optional: g++ 12 warns falsely about it here)
   std::istringstream lines(text);
   std::string line;
   int number = 0;
   while (std::getline(lines, line)) {
     ++number;
     if (line.rfind("## ", 0) == 0) {
-      current.reset();
+      in_table = false;
       for (const auto& [prefix, table] : headings)
-        if (line.rfind(prefix, 0) == 0) current = table;
+        if (line.rfind(prefix, 0) == 0) {
+          current = table;
+          in_table = true;
+        }
       continue;
     }
     std::smatch m;
-    if (!current || !std::regex_search(line, m, row)) continue;
-    auto [it, fresh] = tables[*current].emplace(m[2].str(), DocRow{std::stoi(m[1].str()), number});
+    if (!in_table || !std::regex_search(line, m, row)) continue;
+    auto [it, fresh] = tables[current].emplace(m[2].str(), DocRow{std::stoi(m[1].str()), number});
     EXPECT_TRUE(fresh) << "line " << number << ": " << m[2] << " is documented twice in one table";
   }
   return tables;
