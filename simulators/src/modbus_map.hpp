@@ -40,6 +40,17 @@ inline constexpr int kInCncState = 7;          // 0 idle, 1 run, 2 hold pending,
 inline constexpr int kInExecutedHigh = 8;      // executed blocks, high word
 inline constexpr int kInExecutedLow = 9;       // executed blocks, low word
 inline constexpr int kInPositionFirst = 10;    // X Y Z A C as int32 pairs (high, low), µm / mdeg
+// The same pairs one by one (the daemon reads them by name): X Y Z in µm, A C in millidegrees.
+inline constexpr int kInPositionXHigh = 10;
+inline constexpr int kInPositionXLow = 11;
+inline constexpr int kInPositionYHigh = 12;
+inline constexpr int kInPositionYLow = 13;
+inline constexpr int kInPositionZHigh = 14;
+inline constexpr int kInPositionZLow = 15;
+inline constexpr int kInPositionAHigh = 16;
+inline constexpr int kInPositionALow = 17;
+inline constexpr int kInPositionCHigh = 18;
+inline constexpr int kInPositionCLow = 19;
 inline constexpr int kInCount = 20;
 
 // Holding registers (read/write words).

@@ -63,6 +63,8 @@ class Plc {
   void set_estop(bool pressed);
   void set_door_open(bool open);
   void set_pressure_drop(bool dropped);
+  void set_stall(bool stalled);  // the CNC side reads stall() and stops draining its buffer
+  bool stall() const;
 
   bool estop_pressed() const;
   bool jet_is_on() const;
@@ -72,9 +74,31 @@ class Plc {
   const PlcRegisters& registers() const;
 
  private:
+  void advance(double now_s);       // the time model up to now_s
+  void take_client_bits();          // sim fault coils, alarm_reset
+  void take_heartbeat(double now_s);
+  void take_mailbox();
+  void latch(std::uint16_t code);
+  void try_reset(double now_s);
+  bool heartbeat_alive(double now_s) const;
+  bool pump_running() const;
+  void publish(double now_s);       // derived bits and registers from the state
+
   PlcConfig config_;
   PlcRegisters regs_;
-  // (implementation state: pressure, flows, heartbeat timing, mailbox, faults)
+  double last_s_ = 0;                 // time the model was last advanced to
+  bool started_ = false;              // last_s_ is meaningful
+  double pressure_01mpa_ = 0;
+  double hopper_kg_ = 0;
+  std::uint16_t last_heartbeat_ = 0;
+  std::uint16_t heartbeat_seen_ = 0;
+  bool heartbeat_armed_ = false;
+  double last_heartbeat_s_ = 0;
+  std::uint16_t last_seq_ = 0;        // last mailbox_seq value acted on
+  std::optional<MailboxBlock> pending_;
+  std::uint32_t alarm_causes_ = 0;    // bit per alarm code still latched
+  std::uint16_t alarm_code_ = modbus_map::kAlarmNone;
+  CncSnapshot cnc_;
 };
 
 }  // namespace lamina::sim

@@ -1,0 +1,192 @@
+// docs/modbus-map.md is the register map both sides follow; modbus_map.hpp is the simulator's
+// copy. This reads the document's tables and checks them against the constants, both ways.
+#include <gtest/gtest.h>
+
+#include <cctype>
+#include <fstream>
+#include <map>
+#include <regex>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "modbus_map.hpp"
+
+namespace lamina::sim {
+namespace {
+namespace mm = modbus_map;
+
+// Which table a constant is documented in; the document's "## ..." headings name them.
+enum class Table { coil, sim_coil, input, in, hold, size, alarm };
+
+struct Constant {
+  const char* name;
+  int value;
+  Table table;
+};
+
+#define C(name, table) Constant{#name, mm::name, Table::table}
+// Every constant of modbus_map.hpp (the test below checks this list against the header's text,
+// so a constant added there without being added here, and documented, fails).
+const std::vector<Constant> kConstants{
+    C(kCoilPumpEnable, coil), C(kCoilAbrasiveEnable, coil), C(kCoilJetOn, coil), C(kCoilAlarmReset, coil),
+    C(kCoilCount, size),
+    C(kCoilSimEstop, sim_coil), C(kCoilSimDoorOpen, sim_coil), C(kCoilSimPressureDrop, sim_coil),
+    C(kCoilSimStall, sim_coil), C(kCoilSimEnd, size),
+    C(kInputEstopOk, input), C(kInputDoorClosed, input), C(kInputPumpReady, input), C(kInputJetIsOn, input),
+    C(kInputAlarmLatched, input), C(kInputCncJetRequest, input), C(kInputCount, size),
+    C(kInPressure, in), C(kInAbrasiveFlow, in), C(kInHopperLevel, in), C(kInHeartbeatSeen, in),
+    C(kInMailboxAck, in), C(kInMailboxFree, in), C(kInAlarmCode, in), C(kInCncState, in),
+    C(kInExecutedHigh, in), C(kInExecutedLow, in), C(kInPositionFirst, size),
+    C(kInPositionXHigh, in), C(kInPositionXLow, in), C(kInPositionYHigh, in), C(kInPositionYLow, in),
+    C(kInPositionZHigh, in), C(kInPositionZLow, in), C(kInPositionAHigh, in), C(kInPositionALow, in),
+    C(kInPositionCHigh, in), C(kInPositionCLow, in), C(kInCount, size),
+    C(kHoldPressureSetpoint, hold), C(kHoldHeartbeat, hold), C(kHoldAbrasiveSetpoint, hold),
+    C(kHoldMailboxSeq, hold), C(kHoldMailboxLength, hold), C(kHoldMailboxText, hold),
+    C(kMailboxTextRegisters, size), C(kMailboxMaxChars, size), C(kHoldCount, size),
+    C(kAlarmNone, alarm), C(kAlarmEstop, alarm), C(kAlarmHeartbeat, alarm), C(kAlarmMailboxOverrun, alarm),
+    C(kAlarmMailboxBadBlock, alarm),
+};
+#undef C
+
+std::string snake(const std::string& camel) {
+  std::string out;
+  for (char ch : camel) {
+    if (std::isupper(static_cast<unsigned char>(ch))) {
+      if (!out.empty()) out.push_back('_');
+      out.push_back(static_cast<char>(std::tolower(static_cast<unsigned char>(ch))));
+    } else {
+      out.push_back(ch);
+    }
+  }
+  return out;
+}
+
+// The naming rule at the top of docs/modbus-map.md.
+std::string doc_name(const Constant& c) {
+  std::string rest = std::string(c.name).substr(1);  // without k
+  auto strip = [&](const std::string& prefix) {
+    if (rest.rfind(prefix, 0) == 0) rest = rest.substr(prefix.size());
+  };
+  switch (c.table) {
+    case Table::coil:
+    case Table::sim_coil: strip("Coil"); break;
+    case Table::input: strip("Input"); break;
+    case Table::in: strip("In"); break;
+    case Table::hold: strip("Hold"); break;
+    case Table::alarm: strip("Alarm"); break;
+    case Table::size: break;
+  }
+  return snake(rest);
+}
+
+std::string read_text(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+struct DocRow {
+  int value;
+  int line;
+};
+using DocTables = std::map<Table, std::map<std::string, DocRow>>;
+
+// Rows "| <number> | <name> | ..." under the headings that name a table.
+DocTables parse_doc(const std::string& text) {
+  const std::vector<std::pair<std::string, Table>> headings{
+      {"## Coils", Table::coil},           {"## Simulator-only fault coils", Table::sim_coil},
+      {"## Discrete inputs", Table::input}, {"## Input registers", Table::in},
+      {"## Holding registers", Table::hold}, {"## Sizes and aliases", Table::size},
+      {"## Alarm codes", Table::alarm}};
+  const std::regex row(R"(^\|\s*(\d+)\s*\|\s*([a-z0-9_]+)\s*\|)");
+  DocTables tables;
+  Table current = Table::coil;
+  bool in_table = false;  // (not std::optional: g++ 12 warns falsely about it here)
+  std::istringstream lines(text);
+  std::string line;
+  int number = 0;
+  while (std::getline(lines, line)) {
+    ++number;
+    if (line.rfind("## ", 0) == 0) {
+      in_table = false;
+      for (const auto& [prefix, table] : headings)
+        if (line.rfind(prefix, 0) == 0) {
+          current = table;
+          in_table = true;
+        }
+      continue;
+    }
+    std::smatch m;
+    if (!in_table || !std::regex_search(line, m, row)) continue;
+    auto [it, fresh] = tables[current].emplace(m[2].str(), DocRow{std::stoi(m[1].str()), number});
+    EXPECT_TRUE(fresh) << "line " << number << ": " << m[2] << " is documented twice in one table";
+  }
+  return tables;
+}
+
+const std::string kDocPath = std::string(LAMINA_DOCS_DIR) + "/modbus-map.md";
+const std::string kHeaderPath = std::string(LAMINA_DOCS_DIR) + "/../simulators/src/modbus_map.hpp";
+
+TEST(ModbusMapDoc, EveryConstantIsDocumentedWithItsValue) {
+  const std::string text = read_text(kDocPath);
+  ASSERT_FALSE(text.empty()) << "cannot read " << kDocPath;
+  const DocTables tables = parse_doc(text);
+  for (const auto& c : kConstants) {
+    const std::string name = doc_name(c);
+    const auto table = tables.find(c.table);
+    ASSERT_NE(table, tables.end()) << "no table for " << c.name << " in " << kDocPath;
+    const auto row = table->second.find(name);
+    if (row == table->second.end()) {
+      ADD_FAILURE() << c.name << " is not documented (expected a row `| " << c.value << " | " << name << " |`)";
+      continue;
+    }
+    EXPECT_EQ(row->second.value, c.value)
+        << kDocPath << ":" << row->second.line << ": " << name << " is " << row->second.value
+        << " in the document but " << c.name << " = " << c.value;
+  }
+}
+
+TEST(ModbusMapDoc, EveryDocumentedRowIsAConstant) {
+  const DocTables tables = parse_doc(read_text(kDocPath));
+  std::map<Table, std::set<std::string>> known;
+  for (const auto& c : kConstants) known[c.table].insert(doc_name(c));
+  std::size_t rows = 0;
+  for (const auto& [table, rows_of_table] : tables)
+    for (const auto& [name, row] : rows_of_table) {
+      ++rows;
+      EXPECT_TRUE(known[table].contains(name))
+          << kDocPath << ":" << row.line << ": " << name << " has no constant in modbus_map.hpp";
+    }
+  EXPECT_EQ(rows, kConstants.size());
+}
+
+TEST(ModbusMapDoc, AddressesInOneAreaAreDistinct) {
+  const DocTables tables = parse_doc(read_text(kDocPath));
+  for (Table t : {Table::coil, Table::sim_coil, Table::input, Table::in, Table::hold, Table::alarm}) {
+    std::map<int, std::string> by_address;
+    const auto it = tables.find(t);
+    if (it == tables.end()) continue;
+    for (const auto& [name, row] : it->second) {
+      auto [prev, fresh] = by_address.emplace(row.value, name);
+      EXPECT_TRUE(fresh) << name << " and " << prev->second << " share address " << row.value;
+    }
+  }
+}
+
+TEST(ModbusMapDoc, TheTestKnowsEveryConstantOfTheHeader) {
+  const std::string header = read_text(kHeaderPath);
+  ASSERT_FALSE(header.empty()) << "cannot read " << kHeaderPath;
+  const std::regex declaration(R"(inline\s+constexpr\s+[\w:]+\s+(k\w+)\s*=)");
+  std::set<std::string> in_header;
+  for (auto it = std::sregex_iterator(header.begin(), header.end(), declaration); it != std::sregex_iterator(); ++it)
+    in_header.insert((*it)[1]);
+  std::set<std::string> in_test;
+  for (const auto& c : kConstants) in_test.insert(c.name);
+  EXPECT_EQ(in_header, in_test) << "add new constants to kConstants here and to docs/modbus-map.md";
+}
+
+}  // namespace
+}  // namespace lamina::sim
