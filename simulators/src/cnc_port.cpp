@@ -32,7 +32,9 @@ class PtyPort final : public CncPort {
     if (present == present_) return PortChange::none;
     present_ = present;
     if (present) {
-      ::tcflush(master_, TCIOFLUSH);  // drop what piled up while nobody listened
+      // Drop what the controller said while nobody listened; keep the input — the client may
+      // already have written before we noticed it opened the port.
+      ::tcflush(master_, TCOFLUSH);
       return PortChange::client_connected;
     }
     return PortChange::client_gone;

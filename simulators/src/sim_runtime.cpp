@@ -133,7 +133,7 @@ void SimRuntime::step() {
   machine_.advance(now);
   const bool stalled_by_coil = [&] {
     std::lock_guard lock(plc_mutex_);
-    return plc_.registers().coils[modbus_map::kCoilSimStall] != 0;
+    return plc_.stall();
   }();
   protocol_->set_stalled(stalled_by_coil || (stall_until_wall_ && wall < *stall_until_wall_));
   if (stall_until_wall_ && wall >= *stall_until_wall_) {

@@ -168,11 +168,11 @@ class StreamClient {
   // Read whatever arrives within `wait_s` (returns early when `done(buffer)` is true).
   bool read_until(const std::function<bool(const std::string&)>& done, double wait_s) {
     const auto t0 = std::chrono::steady_clock::now();
-    while (!done(buffer_)) {
+    for (bool first = true; !done(buffer_); first = false) {
       const double left = wait_s - seconds_since(t0);
-      if (left <= 0 || closed_) return done(buffer_);
-      pollfd p{fd_, POLLIN, 0};
-      if (::poll(&p, 1, std::max(1, static_cast<int>(left * 1000))) <= 0) continue;
+      if ((left <= 0 && !first) || closed_) return done(buffer_);
+      pollfd p{fd_, POLLIN, 0};  // always look once, even with no time to wait
+      if (::poll(&p, 1, std::max(0, static_cast<int>(left * 1000))) <= 0) continue;
       char chunk[4096];
       const ssize_t n = ::read(fd_, chunk, sizeof chunk);
       if (n > 0) buffer_.append(chunk, static_cast<std::size_t>(n));

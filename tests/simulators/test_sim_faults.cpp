@@ -69,7 +69,8 @@ TEST(SimFaults, GarbledBytesReachTheControllerChanged) {
   FaultSim s({"--garble", "0.01", "--seed", "7", "--time-scale", "50"});
   StreamClient c = s.connect();
   const auto program = five_axis_program(300);
-  const StreamResult r = stream_counting(c, program, 1024, 30);
+  // A garbled end of line merges two lines: one answer never comes, so the sender stalls (5 s).
+  const StreamResult r = stream_counting(c, program, 1024, 5);
   const auto st = control_status(s.sim.control_port());
   ASSERT_GT(st["bytes_garbled"].get<int>(), 0);
   EXPECT_EQ(s.events("garble").size(), st["bytes_garbled"].get<std::size_t>());
@@ -108,7 +109,7 @@ TEST(SimFaults, AlarmAtLineStopsThereAndLocks) {
   EXPECT_EQ(alarms[0]["seq"], 20);
   for (const auto& b : executed_blocks(read_log(s.log))) {
     EXPECT_LE(b["seq"].get<int>(), 20);
-    if (b["seq"] == 20) EXPECT_EQ(b.value("completed", true), false);
+    if (b["seq"] == 20) { EXPECT_EQ(b.value("completed", true), false); }
   }
   c.buffer().clear();
   c.send("G0X1\n");
@@ -153,10 +154,12 @@ TEST(SimFaults, PressureDropAtTimeTakesThePumpOutOfReady) {
 TEST(SimFaults, StallStopsTakingLinesForItsDuration) {
   FaultSim s({"--stall-at", "0.3", "--stall-for", "600"});
   StreamClient c = s.connect();
-  // One short line at a time: the gap between two oks shows the stall.
+  // One short line at a time for 1.5 s: the gap between two oks shows the stall. (An ok comes
+  // when the line is queued, so a dwell per line keeps the queue from racing ahead.)
   double longest_gap = 0;
-  auto last = std::chrono::steady_clock::now();
-  for (int i = 0; i < 60; ++i) {
+  const auto t0 = std::chrono::steady_clock::now();
+  auto last = t0;
+  for (int i = 0; seconds_since(t0) < 1.5; ++i) {
     c.buffer().clear();
     c.send("G4P0.01\n");
     ASSERT_TRUE(c.wait_for("ok", 3.0)) << "line " << i;

@@ -80,7 +80,7 @@ TEST(SimGrblLink, EveryLineGetsOkAndTheExecutionLogRepeatsTheProgram) {
     EXPECT_GE(blocks[i]["t_start"].get<double>(), t_prev - 1e-9);
     EXPECT_GE(blocks[i]["t_end"].get<double>(), blocks[i]["t_start"].get<double>());
     t_prev = blocks[i]["t_end"];
-    if (i > 0) EXPECT_EQ(blocks[i]["start"], blocks[i - 1]["end"]) << "motion is continuous at block " << i + 1;
+    if (i > 0) { EXPECT_EQ(blocks[i]["start"], blocks[i - 1]["end"]) << "motion is continuous at block " << i + 1; }
   }
   // The last cutting move's target, read back from the program text.
   const std::string& last_move = program[program.size() - 5];
@@ -126,10 +126,13 @@ TEST(SimGrblLink, AClientThatIgnoresTheBufferLosesBytes) {
   std::string flood;
   for (int i = 0; i < 60; ++i) flood += "G4P1\n";  // 300 bytes at once into a 128-byte buffer
   c.send(flood);
-  ASSERT_TRUE(wait_status(s.sim.control_port(), [](const nlohmann::json& st) { return st["bytes_dropped"] > 0; }, 5));
+  // Every byte crosses the wire (at 115200 baud, 26 ms); the ones that met a full buffer are lost.
+  ASSERT_TRUE(wait_status(s.sim.control_port(), [](const nlohmann::json& st) {
+    return st["bytes_received"].get<int>() + st["bytes_dropped"].get<int>() == 300;
+  }, 5));
   const auto st = control_status(s.sim.control_port());
-  EXPECT_LT(st["bytes_received"].get<int>(), 300);
-  EXPECT_EQ(st["bytes_received"].get<int>() + st["bytes_dropped"].get<int>(), 300);
+  EXPECT_GT(st["bytes_dropped"].get<int>(), 0);
+  EXPECT_LE(st["bytes_received"].get<int>(), 128 + 2 * 5) << "the buffer plus the lines the planner took";
 }
 
 TEST(SimGrblLink, StatusReportsFollowTheMotion) {

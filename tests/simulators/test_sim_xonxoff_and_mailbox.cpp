@@ -49,13 +49,16 @@ DripResult drip_feed(StreamClient& c, const std::string& text, double timeout_s)
       const std::size_t n = std::min<std::size_t>(16, text.size() - sent);  // small writes: stop promptly
       c.send(text.substr(sent, n));
       sent += n;
+      // Pace the writes to the wire (115200 baud): what a sender has handed the kernel can no
+      // longer be held back by a DC3, so a drip feeder keeps that backlog small.
+      std::this_thread::sleep_for(std::chrono::microseconds(n * 1'000'000 / 11'520));
     }
   }
   return r;
 }
 
 TEST(SimXonXoff, DripFeedPausesOnDc3ResumesOnDc1AndRunsTheProgram) {
-  XonSim s({"--rx-buffer", "256", "--planner-blocks", "8", "--time-scale", "20"});
+  XonSim s({"--rx-buffer", "256", "--planner-blocks", "8"});  // real time: the machine is slower than the wire
   StreamClient c = StreamClient::open_pty(s.link);
   const auto program = five_axis_program(150);
   std::string text = "%\n";
