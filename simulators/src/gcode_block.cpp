@@ -172,7 +172,9 @@ ParseResult parse_block(std::string_view line, const ParseParams& params) {
 
     // Unknown letters are refused before their number is looked at: the letter is the problem.
     static constexpr std::string_view kKnown = "GMNFPXYZACIJKRTS";
-    if (kKnown.find(letter) == std::string_view::npos) return fail(GrblStatus::unsupported_command);
+    const bool program_number = letter == 'O' && params.accept_program_number;
+    if (kKnown.find(letter) == std::string_view::npos && !program_number)
+      return fail(GrblStatus::unsupported_command);
     double value = 0;
     if (!parse_number(number, value)) return fail(GrblStatus::bad_number_format);
 
@@ -197,13 +199,16 @@ ParseResult parse_block(std::string_view line, const ParseParams& params) {
         break;
       case 'P':
         if (value < 0) return fail(GrblStatus::negative_value);
-        b.dwell_s = value;
+        b.dwell_s = value * params.dwell_p_unit_s;
         break;
       case 'I': b.i_mm = value; break;
       case 'J': b.j_mm = value; break;
       case 'K': b.k_mm = value; break;
       case 'R': b.r_mm = value; break;
       case 'T': case 'S': break;  // accepted, no meaning on a waterjet
+      case 'O':
+        if (!is_integer(value) || value < 0) return fail(GrblStatus::command_value_not_integer);
+        break;
       default:
         b.axis_words[static_cast<std::size_t>(axis_index(letter))] = value;
         any_axis = true;

@@ -65,7 +65,7 @@ struct Block {
   // executor converts them to mm with its modal units (the _mm names are what they become).
   std::optional<double> i_mm, j_mm, k_mm, r_mm;
   std::optional<double> feed_word;                           // F as written
-  std::optional<double> dwell_s;                             // G4 P (seconds, Grbl convention)
+  std::optional<double> dwell_s;                             // G4 P, converted by dwell_p_unit_s
   std::optional<bool> set_inches;                            // G20 true / G21 false
   std::optional<bool> set_relative;                          // G91 true / G90 false
   std::optional<bool> set_inverse_time;                      // G93 true / G94 false
@@ -79,6 +79,10 @@ struct ParseParams {
   std::vector<int> jet_on_mcodes{3};
   std::vector<int> jet_off_mcodes{5};
   std::size_t max_line_chars = 256;  // grblHAL LINE_BUFFER_SIZE is 257 with the terminator
+  // Seconds per unit of G4 P: Grbl and LinuxCNC read seconds (1), Fanuc milliseconds (0.001).
+  double dwell_p_unit_s = 1.0;
+  // Accept an O program number (Fanuc: `O1000` at the head of the program) and ignore it.
+  bool accept_program_number = false;
 };
 
 struct ParseResult {

@@ -84,6 +84,9 @@ int main(int argc, char** argv) {
     if (o.personality == "xonxoff") {  // water marks follow the buffer: DC3 at ¾, DC1 at ¼
       o.xonxoff.high_water_bytes = o.xonxoff.buffer_bytes * 3 / 4;
       o.xonxoff.low_water_bytes = o.xonxoff.buffer_bytes / 4;
+      // A Fanuc reads G4 P in milliseconds and carries an O program number.
+      o.machine.parse.dwell_p_unit_s = 0.001;
+      o.machine.parse.accept_program_number = true;
     }
     if (planner_blocks) o.machine.planner_blocks = planner_blocks;
     if (!soft_min.empty()) o.machine.soft_min = parse_axes(soft_min, "--soft-min");

@@ -147,3 +147,22 @@ TEST(GcodeBlock, LineLongerThanTheBufferOverflows) {
 
 }  // namespace
 }  // namespace lamina::sim
+
+namespace lamina::sim {
+namespace {
+
+TEST(GcodeBlock, FanucDialectReadsProgramNumbersAndDwellInMilliseconds) {
+  ParseParams fanuc;
+  fanuc.accept_program_number = true;
+  fanuc.dwell_p_unit_s = 0.001;
+  EXPECT_EQ(parse_block("O1000(KNOB.STL SHEET 1)", fanuc).status, GrblStatus::ok);
+  EXPECT_EQ(parse_block("O1000", {}).status, GrblStatus::unsupported_command) << "Grbl has no O word";
+  EXPECT_EQ(parse_block("O10.5", fanuc).status, GrblStatus::command_value_not_integer);
+  const auto dwell = parse_block("G4P1000", fanuc);
+  ASSERT_EQ(dwell.status, GrblStatus::ok);
+  EXPECT_DOUBLE_EQ(*dwell.block.dwell_s, 1.0) << "P1000 is one second on a Fanuc";
+  EXPECT_DOUBLE_EQ(*parse_block("G4P1.5", {}).block.dwell_s, 1.5) << "and P1.5 is 1.5 s on Grbl";
+}
+
+}  // namespace
+}  // namespace lamina::sim
