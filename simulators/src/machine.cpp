@@ -56,6 +56,7 @@ GrblStatus Machine::submit_line(std::string_view line, double now_s) {
   planned.line = std::string(line);
   planned.submit_s = now_s;
   planned_pos_ = planned.target;
+  if (!program_running_) moved_in_program_ = false;
   program_running_ = true;  // from the first block after Idle until M2/M30 executes
   starved_ = false;
   queue_.push_back(std::move(planned));
@@ -142,12 +143,16 @@ void Machine::start_next(double t_s) {
 void Machine::finish_running(double t_s) {
   const detail::PlannedBlock& b = running_->block;
   const std::uint64_t seq = b.seq;
+  const double b_duration_s = b.duration_s;
   events_.push_back(ExecutedBlock{b.seq, b.line, b.start, b.target, jet_, running_->t_start_s, t_s, true});
   pos_ = b.target;
   last_end_s_ = t_s;
   ++executed_;
   running_.reset();
-  if (queue_.empty() && program_running_ && !held_ && !alarm_ && !starved_) {
+  if (b_duration_s > 0) moved_in_program_ = true;
+  // Starvation = the machine had to stop because no block was ready. Before the program's first
+  // timed block nothing was moving (the set-up lines run in no time), so that gap is not one.
+  if (queue_.empty() && program_running_ && moved_in_program_ && !held_ && !alarm_ && !starved_) {
     events_.push_back(StarvationEvent{t_s, seq});
     starved_ = true;
     ++starvations_;
@@ -168,6 +173,7 @@ void Machine::reset_modal() {
   jet_ = false;
   held_ = false;
   program_running_ = false;
+  moved_in_program_ = false;
   starved_ = false;
 }
 
@@ -222,7 +228,7 @@ void Machine::cycle_start(double now_s) {
     running_->seg_t0_s = now_s;
   } else {
     last_end_s_ = std::max(last_end_s_, now_s);
-    if (queue_.empty() && program_running_ && !starved_) {
+    if (queue_.empty() && program_running_ && moved_in_program_ && !starved_) {
       // Resumed with nothing to run: the program is starving from now.
       events_.push_back(StarvationEvent{now_s, accepted_});
       starved_ = true;

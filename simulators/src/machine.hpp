@@ -158,6 +158,7 @@ class Machine {
   bool estop_ = false;
   bool jet_ = false;
   bool program_running_ = false;
+  bool moved_in_program_ = false;  // a timed block (motion, dwell) ran in this program
   bool starved_ = false;      // starvation already reported for this empty period
   std::uint64_t accepted_ = 0, executed_ = 0, starvations_ = 0;
   std::vector<MachineEvent> events_;

@@ -1,6 +1,8 @@
 // The simulated CNC's executor: time model, queue, feed hold, reset, alarms, starvation.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <cmath>
 #include <numbers>
 #include <vector>
@@ -314,6 +316,20 @@ TEST(Machine, NoStarvationWhenTheQueueIsKeptFull) {
   m.advance(100);
   EXPECT_EQ(m.starvation_count(), 0u);
   EXPECT_EQ(m.executed_blocks(), 21u);
+}
+
+TEST(Machine, SetUpLinesArrivingSlowlyAreNoStarvation) {
+  Machine m({});
+  ok(m, "G21G90G94", 0);  // no time: the machine never moved, so waiting for line 2 is no stop
+  ok(m, "M3", 0.5);
+  ok(m, "G1X10F600", 1);  // 1-2 s, then the queue runs dry: that one is starvation
+  m.advance(3);
+  ASSERT_EQ(m.starvation_count(), 1u);
+  const auto events = m.take_events();
+  const auto it = std::find_if(events.begin(), events.end(),
+                               [](const MachineEvent& e) { return std::holds_alternative<StarvationEvent>(e); });
+  ASSERT_NE(it, events.end());
+  EXPECT_NEAR(std::get<StarvationEvent>(*it).t_s, 2, 1e-9);
 }
 
 TEST(Machine, ProgramEndStopsTheJetAndEndsTheProgram) {

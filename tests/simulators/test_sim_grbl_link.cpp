@@ -236,3 +236,49 @@ TEST(SimGrblLink, RefusesANonLoopbackAddressAndABadMachineFile) {
 
 }  // namespace
 }  // namespace lamina::sim::testing
+
+namespace lamina::sim::testing {
+namespace {
+
+TEST(SimGrblLink, StarvationIsLoggedWhenTheSenderFallsBehindAndNotWhenItKeepsUp) {
+  // Keeping up: 0.5 mm moves at 1800 mm/min (17 ms each) over a 115200-baud line, counted.
+  {
+    PtySim s({});
+    StreamClient c = StreamClient::open_pty(s.link);
+    ASSERT_TRUE(c.wait_for("Grbl", 3.0));
+    const auto program = five_axis_program(150);
+    ASSERT_TRUE(stream_counting(c, program, 1024, 30).finished);
+    ASSERT_TRUE(wait_status(s.sim.control_port(), [&](const nlohmann::json& st) {
+      return st["executed_blocks"] == program.size();
+    }, 30));
+    EXPECT_EQ(control_status(s.sim.control_port())["starvation"], 0);
+  }
+  // Falling behind: 10 ms moves sent 100 ms apart.
+  PtySim s({});
+  StreamClient c = StreamClient::open_pty(s.link);
+  ASSERT_TRUE(c.wait_for("Grbl", 3.0));
+  for (int i = 1; i <= 5; ++i) {
+    c.send(fmt::format("G1X{}F6000\n", i));
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  const auto st = control_status(s.sim.control_port());
+  EXPECT_EQ(st["starvation"], 5);
+  std::size_t logged = 0;
+  for (const auto& r : read_log(s.log)) logged += r.value("event", "") == "starvation";
+  EXPECT_EQ(logged, 5u);
+}
+
+TEST(SimGrblLink, UnplugAtTimeDropsTheLinkWhileTheMachineFinishesItsQueue) {
+  PtySim s({"--unplug-at", "0.5"});
+  StreamClient c = StreamClient::open_pty(s.link);
+  ASSERT_TRUE(c.wait_for("Grbl", 3.0));
+  c.send("G1X100F6000\n");  // 1 s of motion
+  c.read_until([](const std::string&) { return false; }, 0.8);
+  EXPECT_TRUE(c.closed());
+  EXPECT_FALSE(std::filesystem::exists(s.link)) << "the device node is gone, as an unplugged USB adapter's";
+  ASSERT_TRUE(wait_status(s.sim.control_port(), [](const nlohmann::json& st) { return st["state"] == "idle"; }, 3));
+  EXPECT_NEAR(control_status(s.sim.control_port())["position"][0].get<double>(), 100, 1e-6);
+}
+
+}  // namespace
+}  // namespace lamina::sim::testing
