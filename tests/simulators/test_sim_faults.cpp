@@ -151,6 +151,28 @@ TEST(SimFaults, PressureDropAtTimeTakesThePumpOutOfReady) {
   EXPECT_EQ(s.events("pressure_drop").size(), 1u);
 }
 
+TEST(SimFaults, SilentHeartbeatTurnsTheJetOffAndLatchesAnAlarm) {
+  FaultSim s({"--modbus", "127.0.0.1:0", "--pressure-ramp", "0.1", "--heartbeat-timeout", "300"});
+  PlcClient plc(s.sim.modbus_port());
+  ASSERT_EQ(modbus_write_bit(plc.ctx, 0, 1), 1);  // pump_enable
+  ASSERT_EQ(modbus_write_bit(plc.ctx, 2, 1), 1);  // jet_on
+  // Beat every 50 ms for 0.5 s: the pump comes to pressure and the valve opens.
+  for (uint16_t beat = 1; beat <= 10; ++beat) {
+    ASSERT_EQ(modbus_write_register(plc.ctx, 1, beat), 1);
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  ASSERT_EQ(plc.input_bit(3), 1) << "jet_is_on while the heartbeat is alive";
+  EXPECT_GE(plc.input_register(3), 10) << "heartbeat_seen";
+  const auto silent = std::chrono::steady_clock::now();
+  while (plc.input_bit(3) == 1 && seconds_since(silent) < 2) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  const double off_after_s = seconds_since(silent);
+  EXPECT_EQ(plc.input_bit(3), 0);
+  EXPECT_GT(off_after_s, 0.25) << "not before the 300 ms timeout";
+  EXPECT_LT(off_after_s, 0.6) << "soon after it";
+  EXPECT_EQ(plc.input_bit(4), 1) << "alarm_latched";
+  EXPECT_EQ(plc.input_register(6), 2) << "alarm_code heartbeat";
+}
+
 TEST(SimFaults, StallStopsTakingLinesForItsDuration) {
   FaultSim s({"--stall-at", "0.3", "--stall-for", "600"});
   StreamClient c = s.connect();
