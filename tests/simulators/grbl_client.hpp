@@ -31,7 +31,7 @@ inline StreamResult stream_counting(StreamClient& link, const std::vector<std::s
   const auto t0 = std::chrono::steady_clock::now();
   while (r.oks + r.errors.size() < lines.size() && seconds_since(t0) < timeout_s && r.alarms.empty()) {
     while (next < lines.size() && in_flight_bytes + lines[next].size() + 1 <= rx_bytes) {
-      link.send(lines[next] + "\n");
+      if (!link.send(lines[next] + "\n")) break;
       in_flight.push_back(lines[next].size() + 1);
       in_flight_bytes += lines[next].size() + 1;
       ++next;

@@ -14,6 +14,7 @@
 #include <netinet/in.h>
 
 #include <chrono>
+#include <csignal>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
@@ -28,6 +29,9 @@
 extern char** environ;
 
 namespace lamina::sim::testing {
+
+// A link the simulator closes must show up as a failed write, not kill the test with SIGPIPE.
+inline const bool kSigpipeIgnored = (std::signal(SIGPIPE, SIG_IGN), true);
 
 inline double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -151,9 +155,10 @@ class StreamClient {
     if (fd_ >= 0) ::close(fd_);
   }
 
-  void send(const std::string& bytes) {
+  // False when the link is gone (an unplugged PTY answers EIO, a dropped socket EPIPE).
+  bool send(const std::string& bytes) {
     std::size_t done = 0;
-    while (done < bytes.size()) {
+    while (done < bytes.size() && !closed_) {
       const ssize_t n = ::write(fd_, bytes.data() + done, bytes.size() - done);
       if (n > 0) {
         done += static_cast<std::size_t>(n);
@@ -161,9 +166,10 @@ class StreamClient {
         pollfd p{fd_, POLLOUT, 0};
         ::poll(&p, 1, 10);
       } else {
-        throw std::runtime_error("write to the simulator failed");
+        closed_ = true;
       }
     }
+    return !closed_;
   }
   // Read whatever arrives within `wait_s` (returns early when `done(buffer)` is true).
   bool read_until(const std::function<bool(const std::string&)>& done, double wait_s) {
