@@ -169,11 +169,15 @@ void SimRuntime::move_bytes_in(double wall, double now) {
         log_.write_event("garble", now, {{"from", was}, {"to", byte}});
       }
       protocol_->on_byte(byte, now);
+      if (byte == '\n') ++line_ends_in_;
+      // Unplug right after the N-th line's end: the bytes after it never reach the controller.
+      if (options_.faults.unplug_at_line && !schedule_unplug_done_ &&
+          line_ends_in_ >= *options_.faults.unplug_at_line) {
+        schedule_unplug_done_ = true;
+        unplug(now, fmt::format("line {}", *options_.faults.unplug_at_line));
+        return;
+      }
     }
-    // Stop at the line count that unplugs: the bytes after it never reach the controller.
-    if (options_.faults.unplug_at_line && !schedule_unplug_done_ &&
-        protocol_->counters().lines_received >= *options_.faults.unplug_at_line)
-      break;
   }
 }
 
@@ -224,17 +228,15 @@ void SimRuntime::unplug(double now, const std::string& why) {
   tx_pending_.clear();
   ++unplugs_;
   unplugged_by_fault_ = true;
-  log_.write_event("unplug", now, {{"why", why}, {"lines_received", protocol_->counters().lines_received}});
+  log_.write_event("unplug", now, {{"why", why}, {"line_ends_in", line_ends_in_}});
   if (options_.faults.replug_after_ms) replug_at_wall_ = wall_s() + *options_.faults.replug_after_ms / 1000.0;
 }
 
 void SimRuntime::apply_schedule(double wall, double now) {
   const auto& f = options_.faults;
-  if (!schedule_unplug_done_ &&
-      ((f.unplug_at_line && protocol_->counters().lines_received >= *f.unplug_at_line) ||
-       (f.unplug_at_s && now >= *f.unplug_at_s))) {
+  if (!schedule_unplug_done_ && f.unplug_at_s && now >= *f.unplug_at_s) {
     schedule_unplug_done_ = true;
-    unplug(now, f.unplug_at_line ? fmt::format("line {}", *f.unplug_at_line) : fmt::format("t {}", *f.unplug_at_s));
+    unplug(now, fmt::format("t {}", *f.unplug_at_s));
   }
   if (replug_at_wall_ && wall >= *replug_at_wall_) {
     replug_at_wall_.reset();

@@ -68,6 +68,7 @@ class SimRuntime {
   bool schedule_unplug_done_ = false, schedule_estop_done_ = false, schedule_pressure_done_ = false,
        schedule_stall_done_ = false;
   std::uint64_t unplugs_ = 0;
+  std::uint64_t line_ends_in_ = 0;  // LF bytes that reached the controller (for --unplug-at-line)
 };
 
 }  // namespace lamina::sim

@@ -107,6 +107,7 @@ TEST(SimGrblLink, BytesMoveAtTheConfiguredBaudBothWays) {
     return n >= 200;
   }, 10));
   const double in_rate = static_cast<double>(burst.size()) / seconds_since(t0);
+  RecordProperty("host_to_controller_bytes_per_s", std::to_string(in_rate));
   EXPECT_NEAR(in_rate, bytes_per_s, 0.05 * bytes_per_s) << "host → controller bytes/s";
 
   // Controller → host: 50 status reports, each tens of bytes.
@@ -115,6 +116,7 @@ TEST(SimGrblLink, BytesMoveAtTheConfiguredBaudBothWays) {
   c.send(std::string(50, '?'));
   ASSERT_TRUE(c.read_until([](const std::string& b) { return std::count(b.begin(), b.end(), '>') >= 50; }, 10));
   const double out_rate = static_cast<double>(c.buffer().size()) / seconds_since(t1);
+  RecordProperty("controller_to_host_bytes_per_s", std::to_string(out_rate));
   EXPECT_NEAR(out_rate, bytes_per_s, 0.05 * bytes_per_s) << "controller → host bytes/s";
 }
 
