@@ -1,0 +1,81 @@
+#pragma once
+// The cell's PLC over Modbus TCP (libmodbus, on its own thread: libmodbus blocks). Register
+// map: docs/modbus-map.md. Before a cut it brings the cell up (e-stop released, door closed,
+// pump on and at pressure within a timeout, abrasive on, jet consent); during the cut it keeps
+// the heartbeat going and watches pressure and interlocks; it owns the jet's independent off
+// path (the jet_on coil). Transport errors (ETIMEDOUT, EIO…) lead to bounded, logged reconnects.
+#include <chrono>
+#include <expected>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "lamina/drivers/link_error.hpp"
+
+namespace lamina::drivers {
+
+struct CellIoSettings {
+  std::string host = "127.0.0.1";
+  int port = 502;
+  int unit_id = 1;
+  double response_timeout_s = 0.5;
+  double heartbeat_period_s = 0.2;       // the PLC's watchdog must be longer
+  double poll_period_s = 0.05;           // interlocks and pressure read this often while cutting
+  std::uint16_t pressure_setpoint_01mpa = 3800;
+  std::uint16_t abrasive_g_per_min = 350;
+  double pump_ready_timeout_s = 10;      // pump on → pump_ready
+  double min_pressure_fraction = 0.9;    // below this × set point while cutting: pressure fault
+  int max_reconnects = 3;                // per fault, then the cell is declared lost
+};
+
+enum class CellFault {
+  estop,          // estop_ok fell
+  door_open,      // door_closed fell
+  pressure_low,   // pump_ready fell or pressure below min_pressure_fraction × set point
+  plc_alarm,      // the PLC latched an alarm (heartbeat watchdog, mailbox…)
+  link_lost,      // Modbus unreachable after max_reconnects
+};
+
+struct CellFaultReport {
+  CellFault fault{};
+  std::string message;  // what was read, e.g. "pressure 112.0 MPa < 342.0 MPa (0.9 × 380)"
+};
+
+struct CellStatus {
+  bool connected = false;
+  bool estop_ok = false, door_closed = false, pump_ready = false, jet_is_on = false, alarm_latched = false;
+  double pressure_mpa = 0;
+  double abrasive_g_per_min = 0;
+  int alarm_code = 0;
+  int reconnects = 0;
+};
+
+class CellIo {
+ public:
+  // Starts the Modbus thread. Does not connect yet.
+  explicit CellIo(CellIoSettings settings);
+  ~CellIo();  // jet off (best effort), stops the thread
+  CellIo(const CellIo&) = delete;
+  CellIo& operator=(const CellIo&) = delete;
+
+  // Blocking: connect, check e-stop and door, pump on with its set point, wait for pump_ready,
+  // abrasive on, heartbeat running, jet consent (jet_on = 1). The error names the failed
+  // condition and the value read.
+  std::expected<void, LinkError> prepare_cut();
+  // The independent off path: jet_on = 0 now, from any thread, ahead of anything queued.
+  void jet_off();
+  // After the cut (or a stop): jet off, abrasive off, pump to idle (pump_enable = 0). Blocking.
+  std::expected<void, LinkError> finish_cut();
+  // While a cut is prepared, the first fault seen (sticky until the next prepare_cut); the
+  // callback (set before prepare_cut) runs on the Modbus thread when it happens.
+  void on_fault(std::function<void(const CellFaultReport&)> callback);
+  std::optional<CellFaultReport> fault() const;
+  CellStatus status() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace lamina::drivers

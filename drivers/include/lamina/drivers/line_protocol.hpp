@@ -1,0 +1,102 @@
+#pragma once
+// A streaming protocol without I/O (sans-IO, like ruckig's data in / data out): it is told what
+// arrived and asked what may be sent, so the same code runs over a serial port, a PTY or TCP,
+// and its tests script the controller byte by byte. The Streamer (streamer.hpp) owns the I/O.
+//
+// Lines are the program's lines without end-of-line; `index` is the line's 0-based position in
+// the program the caller loaded (so a resumed job keeps the original numbering).
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <variant>
+#include <vector>
+
+#include "lamina/drivers/controller_status.hpp"
+
+namespace lamina::drivers {
+
+enum class RealtimeCommand { status, feed_hold, resume, reset };
+
+struct LineSpan {  // lines [first, first + count) of the program, in order
+  std::vector<std::string> lines;
+  std::size_t first_index = 0;
+};
+
+// Events a protocol reports from received bytes.
+struct LineAccepted {     // the controller took line `index` (Grbl `ok`; XON/XOFF: written out)
+  std::size_t index = 0;
+};
+struct LineRejected {     // error:N on line `index`; the job must stop
+  std::size_t index = 0;
+  int code = 0;
+  std::string meaning;    // "unsupported command (20)"
+};
+struct ControllerAlarm {  // ALARM:N, NAK after DC3: motion stopped, the job must stop
+  int code = 0;
+  std::string meaning;
+};
+struct ControllerReset {  // banner / SYN: the controller reset (queue flushed)
+  std::string text;
+};
+struct StatusReceived {
+  ControllerStatus status;
+};
+struct ControllerInfo {   // [OPT:…] / [AXS:…] / VER: what was learned at connect
+  std::optional<int> planner_blocks;
+  std::optional<int> rx_buffer_bytes;
+  std::optional<int> axes;
+  std::string axis_letters;
+};
+struct ProtocolViolation { // bytes that cannot be right (an ok with nothing in flight, garbage)
+  std::string what;
+};
+using ProtocolEvent = std::variant<LineAccepted, LineRejected, ControllerAlarm, ControllerReset, StatusReceived,
+                                   ControllerInfo, ProtocolViolation>;
+
+class LineProtocol {
+ public:
+  virtual ~LineProtocol() = default;
+  virtual std::string name() const = 0;
+
+  // Bytes to send once after connecting, before any program line (e.g. "$I\n" to read the
+  // buffer sizes); the protocol reports what it learned as ControllerInfo.
+  virtual std::string handshake() = 0;
+  virtual bool handshake_done() const = 0;
+
+  // Load lines to stream. Replaces whatever was loaded; nothing may be in flight.
+  virtual void load(LineSpan span) = 0;
+  // Bytes that may go on the wire now (window, XOFF, one-in-flight…), marked as sent.
+  virtual std::string take_sendable() = 0;
+  // Stop handing out program bytes (after an error or alarm, or on the operator's stop).
+  virtual void halt() = 0;
+  // Bytes that arrived; the events they complete, in order.
+  virtual std::vector<ProtocolEvent> on_received(std::string_view bytes) = 0;
+  // Bytes for a real-time command, sent ahead of the line queue; empty when the protocol has
+  // none (then the caller uses another path, e.g. the PLC).
+  virtual std::string realtime(RealtimeCommand command) const = 0;
+  // After an error:N, what to send to leave the controller's error lock the documented way
+  // (grblHAL: an empty line) before anything else; empty if nothing is needed.
+  virtual std::string clear_error_lock() const = 0;
+
+  virtual std::size_t lines_sent() const = 0;      // of the loaded span
+  virtual std::size_t lines_accepted() const = 0;  // acknowledged (or, for XON/XOFF, written)
+  virtual bool finished() const = 0;               // every loaded line accepted
+};
+
+struct GrblProtocolSettings {
+  // 0: learn the receive buffer from `[OPT:…]` at the handshake (grblHAL reports it); a Grbl
+  // that does not report it gets 128 (classic Grbl), unless configured.
+  std::size_t rx_buffer_bytes = 0;
+};
+struct XonXoffProtocolSettings {
+  std::size_t chunk_bytes = 16;  // most bytes handed out per call: a DC3 stops us within this
+  bool send_percent_frame = true;  // `%` before and after the program when the program lacks it
+};
+
+std::unique_ptr<LineProtocol> make_grbl_protocol(GrblProtocolSettings settings = {});
+std::unique_ptr<LineProtocol> make_send_response_protocol();  // one line in flight, ok/error
+std::unique_ptr<LineProtocol> make_xonxoff_protocol(XonXoffProtocolSettings settings = {});
+
+}  // namespace lamina::drivers

@@ -1,0 +1,53 @@
+#pragma once
+// What a job needs from the link to the CNC, whatever carries it: a byte stream with a
+// LineProtocol (streamer.hpp) or the PLC's G-code block mailbox (modbus_block_link.hpp).
+// Thread-safe: request() and stop() may be called from any thread; events are delivered on the
+// link's own thread.
+#include <cstddef>
+#include <functional>
+#include <optional>
+#include <string>
+
+#include "lamina/drivers/controller_status.hpp"
+#include "lamina/drivers/line_protocol.hpp"
+#include "lamina/drivers/link_error.hpp"
+
+namespace lamina::drivers {
+
+struct LinkProgress {
+  std::size_t lines_total = 0;     // in the loaded span
+  std::size_t lines_sent = 0;
+  std::size_t lines_accepted = 0;  // acknowledged by the controller
+  std::size_t bytes_sent = 0;
+  double seconds = 0;              // since start()
+  std::optional<ControllerStatus> last_status;
+};
+
+// The link's view of how streaming ended (or why it stopped).
+struct LinkOutcome {
+  bool completed = false;          // every line accepted
+  std::optional<LinkError> error;  // set when it stopped early
+  std::size_t last_accepted_index = 0;  // program index of the last accepted line (+1 if none: first_index)
+};
+
+struct LinkCallbacks {
+  std::function<void(const LinkProgress&)> on_progress;     // at most every status period
+  std::function<void(const ControllerStatus&)> on_status;
+  std::function<void(const LinkOutcome&)> on_done;          // once per start()
+};
+
+class MachineLink {
+ public:
+  virtual ~MachineLink() = default;
+  // Connect (if needed), run the protocol's handshake and stream `span`. Returns at once.
+  virtual void start(LineSpan span, LinkCallbacks callbacks) = 0;
+  // Real-time command, ahead of the queue (feed hold, resume, reset, status).
+  virtual void request(RealtimeCommand command) = 0;
+  // Stop streaming (no more lines); does not move the machine. on_done follows.
+  virtual void stop(LinkError why) = 0;
+  virtual LinkProgress progress() const = 0;
+  // Blocks until the last start() finished; nullopt on timeout.
+  virtual std::optional<LinkOutcome> wait(double timeout_s) = 0;
+};
+
+}  // namespace lamina::drivers

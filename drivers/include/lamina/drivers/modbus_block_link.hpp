@@ -1,0 +1,39 @@
+#pragma once
+// A MachineLink for controllers that take their program over Modbus: one G-code block and its
+// sequence number into the PLC's mailbox, then wait for the acknowledge (docs/modbus-map.md,
+// "Block mailbox"). libmodbus on the link's own thread. Real-time commands go through the PLC's
+// CNC coils (feed hold, cycle start, reset) and status comes from its CNC registers.
+#include <memory>
+#include <string>
+
+#include "lamina/drivers/machine_link.hpp"
+
+namespace lamina::drivers {
+
+struct ModbusBlockSettings {
+  std::string host = "127.0.0.1";
+  int port = 502;
+  int unit_id = 1;
+  double response_timeout_s = 0.5;
+  double ack_timeout_s = 5;        // a block not acknowledged within this: timeout, job stops
+  double status_period_s = 0.2;
+  int max_reconnects = 3;
+};
+
+class ModbusBlockLink final : public MachineLink {
+ public:
+  explicit ModbusBlockLink(ModbusBlockSettings settings);
+  ~ModbusBlockLink() override;
+
+  void start(LineSpan span, LinkCallbacks callbacks) override;
+  void request(RealtimeCommand command) override;
+  void stop(LinkError why) override;
+  LinkProgress progress() const override;
+  std::optional<LinkOutcome> wait(double timeout_s) override;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace lamina::drivers

@@ -1,0 +1,51 @@
+#pragma once
+// A MachineLink over a byte stream: one Transport, one LineProtocol, one thread running a
+// boost::asio::io_context. Real-time commands are written ahead of queued program bytes; the
+// status is polled at a fixed period; every write's latency from request to wire is measured.
+#include <expected>
+#include <functional>
+#include <memory>
+
+#include "lamina/drivers/machine_link.hpp"
+#include "lamina/drivers/transport.hpp"
+
+namespace lamina::drivers {
+
+struct StreamerSettings {
+  double status_period_s = 0.2;    // 5 Hz '?' (0: no polling)
+  double handshake_timeout_s = 5;  // banner / [OPT:] after connecting
+  double silence_timeout_s = 10;   // lines in flight and nothing heard for this long: timeout
+  // Pace program bytes to the line rate (bytes/s, 0 = unpaced): what sits in a kernel buffer
+  // cannot be held back by a DC3, so an XON/XOFF sender keeps that backlog small.
+  double pace_bytes_per_s = 0;
+};
+
+// Opens the transport on the link's own io_context thread.
+using TransportFactory =
+    std::function<std::expected<std::unique_ptr<Transport>, LinkError>(boost::asio::io_context&)>;
+
+struct RealtimeLatency {  // request() → bytes handed to the transport, seconds
+  double max_s = 0;
+  double mean_s = 0;
+  std::size_t count = 0;
+};
+
+class Streamer final : public MachineLink {
+ public:
+  Streamer(TransportFactory open, std::unique_ptr<LineProtocol> protocol, StreamerSettings settings);
+  ~Streamer() override;
+
+  void start(LineSpan span, LinkCallbacks callbacks) override;
+  void request(RealtimeCommand command) override;
+  void stop(LinkError why) override;
+  LinkProgress progress() const override;
+  std::optional<LinkOutcome> wait(double timeout_s) override;
+
+  RealtimeLatency realtime_latency() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace lamina::drivers
