@@ -80,6 +80,10 @@ class LineProtocol {
   // (grblHAL: an empty line) before anything else; empty if nothing is needed.
   virtual std::string clear_error_lock() const = 0;
 
+  // Lines that take the controller out of an alarm after a reset (grbl: `$X`); streamed as a
+  // span of their own by MachineLink::recover().
+  virtual std::vector<std::string> unlock_lines() const { return {}; }
+
   virtual std::size_t lines_sent() const = 0;      // of the loaded span
   virtual std::size_t lines_accepted() const = 0;  // acknowledged (or, for XON/XOFF, written)
   virtual bool finished() const = 0;               // every loaded line accepted

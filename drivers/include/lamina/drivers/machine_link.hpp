@@ -21,13 +21,17 @@ struct LinkProgress {
   std::size_t bytes_sent = 0;
   double seconds = 0;              // since start()
   std::optional<ControllerStatus> last_status;
+  std::size_t statuses_received = 0;     // counts reports, so a caller can wait for a fresh one
+  std::optional<int> planner_blocks;     // as the controller reported at the handshake
+  std::optional<int> rx_buffer_bytes;
 };
 
 // The link's view of how streaming ended (or why it stopped).
 struct LinkOutcome {
   bool completed = false;          // every line accepted
   std::optional<LinkError> error;  // set when it stopped early
-  std::size_t last_accepted_index = 0;  // program index of the last accepted line (+1 if none: first_index)
+  std::size_t lines_accepted = 0;       // of the span started
+  std::size_t last_accepted_index = 0;  // program index of the last accepted line (first_index if none)
 };
 
 struct LinkCallbacks {
@@ -46,6 +50,9 @@ class MachineLink {
   // Stop streaming (no more lines); does not move the machine. on_done follows.
   virtual void stop(LinkError why) = 0;
   virtual LinkProgress progress() const = 0;
+  // After a stop, before streaming from a resume point: clear the controller's queue and its
+  // alarm or error lock (grbl: soft reset, then $X). Blocking.
+  virtual std::optional<LinkError> recover(double timeout_s) = 0;
   // Blocks until the last start() finished; nullopt on timeout.
   virtual std::optional<LinkOutcome> wait(double timeout_s) = 0;
 };

@@ -29,6 +29,7 @@ class ModbusBlockLink final : public MachineLink {
   void request(RealtimeCommand command) override;
   void stop(LinkError why) override;
   LinkProgress progress() const override;
+  std::optional<LinkError> recover(double timeout_s) override;
   std::optional<LinkOutcome> wait(double timeout_s) override;
 
  private:

@@ -39,6 +39,7 @@ class Streamer final : public MachineLink {
   void request(RealtimeCommand command) override;
   void stop(LinkError why) override;
   LinkProgress progress() const override;
+  std::optional<LinkError> recover(double timeout_s) override;
   std::optional<LinkOutcome> wait(double timeout_s) override;
 
   RealtimeLatency realtime_latency() const;

@@ -1,0 +1,83 @@
+#pragma once
+// One sheet's program cut on the cell: bring the cell up (CellIo, optional), stream the program
+// through a MachineLink, watch both, and on any fault stop safely — feed hold through the link,
+// jet off through the PLC (the independent path), record where it stopped — and wait for the
+// operator. It never resumes by itself: resume() is the operator's call, and restarts at the
+// start of the contour that was being cut (resume_point.hpp).
+#include <atomic>
+#include <cstddef>
+#include <functional>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "lamina/drivers/cell_io.hpp"
+#include "lamina/drivers/machine_link.hpp"
+#include "lamina/drivers/resume_point.hpp"
+
+namespace lamina::drivers {
+
+struct CutJobSettings {
+  double stop_timeout_s = 5;        // feed hold → the machine reports Hold / Idle / Alarm
+  double finish_timeout_s = 24 * 3600;  // everything accepted → the machine is Idle
+  double safe_z_mm = 10;
+  std::size_t planner_blocks = 0;   // 0: as the controller reported ([OPT:]); else configured
+};
+
+enum class CutState { ready, preparing, cutting, stopping, stopped, completed, failed };
+const char* to_string(CutState state);
+
+struct CutReport {
+  CutState state = CutState::ready;
+  std::optional<LinkError> reason;          // why it stopped or failed
+  std::size_t lines_total = 0;
+  std::size_t lines_accepted = 0;           // program lines acknowledged over all attempts
+  std::size_t first_unfinished_line = 0;    // 0-based; == lines_total when all ran
+  std::optional<ResumePlan> resume;         // set when stopped
+  std::optional<ControllerStatus> last_status;
+  double seconds = 0;
+  std::size_t bytes_sent = 0;
+};
+
+class CutJob {
+ public:
+  // `cell` may be null (no PLC: dry runs, tests of the link alone).
+  CutJob(MachineLink& link, CellIo* cell, std::vector<std::string> program, CutJobSettings settings = {});
+
+  // Blocking: the whole program, or until it stops. Then report().state is completed or stopped
+  // (or failed when the cell could not be brought up).
+  CutReport run();
+  // Blocking: the operator's resume of a stopped job, from report().resume.
+  CutReport resume();
+
+  // From any thread (keyboard, daemon): feed hold / cycle start without stopping the job, and
+  // abort (stops the job like a fault, reason cancelled).
+  void hold();
+  void continue_motion();
+  void abort(std::string why);
+
+  CutReport report() const;
+  void on_progress(std::function<void(const CutReport&)> callback);
+
+ private:
+  CutReport stream_from(std::size_t from, std::vector<std::string> preamble);
+  void stop_safely(LinkError why);
+  void set_state(CutState state);
+
+  MachineLink& link_;
+  CellIo* cell_;
+  std::vector<std::string> program_;
+  CutJobSettings settings_;
+  mutable std::mutex mutex_;
+  CutReport report_;
+  std::function<void(const CutReport&)> progress_;
+  std::atomic<bool> stopping_{false};
+  std::optional<LinkError> stop_reason_;
+  std::size_t span_first_ = 0;
+  // Acknowledged lines and planner occupancy at the last status report (for the resume point).
+  std::size_t accepted_at_status_ = 0;
+  std::optional<std::size_t> queued_at_status_;
+};
+
+}  // namespace lamina::drivers

@@ -1,0 +1,233 @@
+#include "lamina/drivers/cut_job.hpp"
+
+#include <chrono>
+#include <thread>
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+namespace lamina::drivers {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+bool stopped_moving(ControllerState s) {
+  return s == ControllerState::hold || s == ControllerState::idle || s == ControllerState::alarm ||
+         s == ControllerState::door;
+}
+
+}  // namespace
+
+const char* to_string(CutState state) {
+  switch (state) {
+    case CutState::ready: return "ready";
+    case CutState::preparing: return "preparing";
+    case CutState::cutting: return "cutting";
+    case CutState::stopping: return "stopping";
+    case CutState::stopped: return "stopped";
+    case CutState::completed: return "completed";
+    case CutState::failed: return "failed";
+  }
+  return "?";
+}
+
+CutJob::CutJob(MachineLink& link, CellIo* cell, std::vector<std::string> program, CutJobSettings settings)
+    : link_(link), cell_(cell), program_(std::move(program)), settings_(settings) {
+  report_.lines_total = program_.size();
+}
+
+CutReport CutJob::report() const {
+  std::lock_guard lock(mutex_);
+  return report_;
+}
+
+void CutJob::on_progress(std::function<void(const CutReport&)> callback) { progress_ = std::move(callback); }
+
+void CutJob::set_state(CutState state) {
+  std::lock_guard lock(mutex_);
+  report_.state = state;
+}
+
+void CutJob::hold() { link_.request(RealtimeCommand::feed_hold); }
+void CutJob::continue_motion() { link_.request(RealtimeCommand::resume); }
+
+void CutJob::abort(std::string why) {
+  // Jet first: the PLC path does not wait for anything queued on the serial line.
+  if (cell_) cell_->jet_off();
+  link_.request(RealtimeCommand::feed_hold);
+  link_.stop(LinkError{LinkErrorCode::cancelled, std::move(why)});
+}
+
+CutReport CutJob::run() {
+  if (cell_) {
+    set_state(CutState::preparing);
+    cell_->on_fault([this](const CellFaultReport& fault) {
+      // The PLC already dropped the jet; hold the motion and stop the stream.
+      cell_->jet_off();
+      link_.request(RealtimeCommand::feed_hold);
+      link_.stop(LinkError{LinkErrorCode::interlock, fault.message});
+    });
+    if (auto ready = cell_->prepare_cut(); !ready) {
+      std::lock_guard lock(mutex_);
+      report_.state = CutState::failed;
+      report_.reason = ready.error();
+      return report_;
+    }
+  }
+  return stream_from(0, {});
+}
+
+CutReport CutJob::resume() {
+  std::optional<ResumePlan> plan;
+  {
+    std::lock_guard lock(mutex_);
+    if (report_.state != CutState::stopped || !report_.resume) return report_;
+    plan = report_.resume;
+  }
+  if (auto error = link_.recover(settings_.stop_timeout_s)) {
+    std::lock_guard lock(mutex_);
+    report_.reason = *error;
+    return report_;  // still stopped: the operator sees why the controller did not recover
+  }
+  if (cell_) {
+    if (auto ready = cell_->prepare_cut(); !ready) {
+      std::lock_guard lock(mutex_);
+      report_.reason = ready.error();
+      return report_;
+    }
+  }
+  spdlog::info("cut: resuming at line {} (contour {})", plan->restart_index + 1, plan->contour);
+  return stream_from(plan->restart_index, plan->preamble);
+}
+
+CutReport CutJob::stream_from(std::size_t from, std::vector<std::string> preamble) {
+  stopping_ = false;
+  set_state(CutState::cutting);
+  const auto started = Clock::now();
+  if (!preamble.empty()) {
+    link_.start(LineSpan{std::move(preamble), 0}, {});
+    const auto outcome = link_.wait(settings_.stop_timeout_s * 4);
+    if (!outcome || !outcome->completed) {
+      stop_safely(outcome && outcome->error ? *outcome->error
+                                            : LinkError{LinkErrorCode::timeout, "the resume preamble was not accepted"});
+      return report();
+    }
+  }
+  span_first_ = from;
+  {
+    std::lock_guard lock(mutex_);
+    accepted_at_status_ = from;
+    queued_at_status_.reset();
+  }
+  LinkCallbacks callbacks;
+  callbacks.on_status = [this](const ControllerStatus& status) {
+    const LinkProgress p = link_.progress();
+    std::lock_guard lock(mutex_);
+    report_.last_status = status;
+    // An alarm flushes the controller's queue: its Bf then says nothing of what ran.
+    if (status.state == ControllerState::alarm || stopping_) return;
+    const auto capacity = settings_.planner_blocks ? std::optional<int>(static_cast<int>(settings_.planner_blocks))
+                                                   : p.planner_blocks;
+    if (capacity && status.planner_blocks_free) {
+      accepted_at_status_ = span_first_ + p.lines_accepted;
+      queued_at_status_ = static_cast<std::size_t>(std::max(0, *capacity - *status.planner_blocks_free));
+    }
+  };
+  callbacks.on_progress = [this](const LinkProgress& p) {
+    {
+      std::lock_guard lock(mutex_);
+      report_.lines_accepted = span_first_ + p.lines_accepted;
+      report_.bytes_sent = p.bytes_sent;
+    }
+    if (progress_) progress_(report());
+  };
+  std::vector<std::string> lines(program_.begin() + static_cast<std::ptrdiff_t>(from), program_.end());
+  link_.start(LineSpan{std::move(lines), from}, callbacks);
+  auto outcome = link_.wait(settings_.finish_timeout_s);
+  if (!outcome) {
+    link_.stop(LinkError{LinkErrorCode::timeout, "the program did not finish in time"});
+    outcome = link_.wait(settings_.stop_timeout_s);
+  }
+  if (outcome && outcome->completed) {
+    // Everything is in the controller; the cut is done when it has run it all (Idle, twice,
+    // in reports asked for after the last line went out).
+    const std::size_t seen = link_.progress().statuses_received;
+    int idle_reports = 0;
+    std::size_t last_seen = seen;
+    const auto deadline = Clock::now() + std::chrono::duration<double>(settings_.finish_timeout_s);
+    while (Clock::now() < deadline && !stopping_) {
+      const LinkProgress p = link_.progress();
+      if (p.statuses_received != last_seen && p.last_status) {
+        last_seen = p.statuses_received;
+        idle_reports = p.last_status->state == ControllerState::idle ? idle_reports + 1 : 0;
+        if (p.last_status->state == ControllerState::alarm) {
+          stop_safely(LinkError{LinkErrorCode::controller_alarm, "the controller alarmed while finishing the program"});
+          return report();
+        }
+        if (idle_reports >= 2) break;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    if (stopping_ || idle_reports < 2) {
+      stop_safely(stop_reason_.value_or(LinkError{LinkErrorCode::timeout, "the machine did not finish the program"}));
+      return report();
+    }
+    if (cell_) (void)cell_->finish_cut();
+    std::lock_guard lock(mutex_);
+    report_.state = CutState::completed;
+    report_.lines_accepted = program_.size();
+    report_.first_unfinished_line = program_.size();
+    report_.resume.reset();
+    report_.reason.reset();
+    report_.seconds += std::chrono::duration<double>(Clock::now() - started).count();
+    return report_;
+  }
+  stop_safely(outcome && outcome->error ? *outcome->error : LinkError{LinkErrorCode::timeout, "no outcome"});
+  std::lock_guard lock(mutex_);
+  report_.seconds += std::chrono::duration<double>(Clock::now() - started).count();
+  return report_;
+}
+
+void CutJob::stop_safely(LinkError why) {
+  stopping_ = true;
+  set_state(CutState::stopping);
+  spdlog::warn("cut: stopping: {}", why.message);
+  if (cell_) cell_->jet_off();
+  link_.request(RealtimeCommand::feed_hold);
+  // Wait for a report asked after the hold that says the axes stand still.
+  const std::size_t before = link_.progress().statuses_received;
+  const auto deadline = Clock::now() + std::chrono::duration<double>(settings_.stop_timeout_s);
+  std::optional<ControllerStatus> still;
+  while (Clock::now() < deadline) {
+    const LinkProgress p = link_.progress();
+    if (p.statuses_received > before + 1 && p.last_status && stopped_moving(p.last_status->state)) {
+      still = p.last_status;
+      break;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  const LinkProgress p = link_.progress();
+  std::lock_guard lock(mutex_);
+  std::size_t accepted = accepted_at_status_;
+  std::size_t queued = queued_at_status_.value_or(program_.size());  // unknown: assume all may be queued
+  const auto capacity = settings_.planner_blocks ? std::optional<int>(static_cast<int>(settings_.planner_blocks))
+                                                 : p.planner_blocks;
+  if (still && still->state == ControllerState::hold && capacity && still->planner_blocks_free) {
+    // Held with its queue intact: what is queued is exactly what has not run.
+    accepted = span_first_ + p.lines_accepted;
+    queued = static_cast<std::size_t>(std::max(0, *capacity - *still->planner_blocks_free));
+  }
+  report_.first_unfinished_line = first_unfinished_line(program_, accepted, queued);
+  report_.reason = why;
+  report_.last_status = still ? still : report_.last_status;
+  if (auto plan = plan_resume(program_, report_.first_unfinished_line, settings_.safe_z_mm)) {
+    report_.resume = *plan;
+  } else {
+    report_.resume.reset();
+    report_.reason->message += "; " + plan.error().message;
+  }
+  report_.state = CutState::stopped;
+  stop_reason_ = why;
+}
+
+}  // namespace lamina::drivers

@@ -1,0 +1,138 @@
+#include "lamina/drivers/resume_point.hpp"
+
+#include <cctype>
+#include <charconv>
+#include <optional>
+
+#include <fmt/format.h>
+
+namespace lamina::drivers {
+namespace {
+
+// The line without comments, upper-case, no spaces.
+std::string words_of(std::string_view line) {
+  std::string out;
+  bool in_paren = false;
+  for (char c : line) {
+    if (in_paren) {
+      in_paren = c != ')';
+      continue;
+    }
+    if (c == '(') {
+      in_paren = true;
+      continue;
+    }
+    if (c == ';') break;
+    if (!std::isspace(static_cast<unsigned char>(c))) out += static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  }
+  return out;
+}
+
+std::optional<double> word_value(const std::string& words, char letter) {
+  for (std::size_t i = 0; i < words.size(); ++i) {
+    if (words[i] != letter) continue;
+    std::size_t j = i + 1;
+    while (j < words.size() && (std::isdigit(static_cast<unsigned char>(words[j])) || words[j] == '.' ||
+                                words[j] == '-' || words[j] == '+'))
+      ++j;
+    try {
+      return std::stod(words.substr(i + 1, j - i - 1));
+    } catch (const std::exception&) {
+      return std::nullopt;
+    }
+  }
+  return std::nullopt;
+}
+
+bool has_g(const std::string& words, int code) {
+  for (std::size_t i = 0; i < words.size(); ++i) {
+    if (words[i] != 'G') continue;
+    std::size_t j = i + 1;
+    while (j < words.size() && (std::isdigit(static_cast<unsigned char>(words[j])) || words[j] == '.')) ++j;
+    int value = -1;
+    const auto text = words.substr(i + 1, j - i - 1);
+    if (std::from_chars(text.data(), text.data() + text.size(), value).ec == std::errc() && value == code &&
+        text.find('.') == std::string::npos)
+      return true;
+  }
+  return false;
+}
+
+// `(CONTOUR n …)` → n.
+std::optional<int> contour_marker(std::string_view line) {
+  constexpr std::string_view kMarker = "(CONTOUR ";
+  const auto at = line.find(kMarker);
+  if (at == std::string_view::npos) return std::nullopt;
+  int n = -1;
+  const char* begin = line.data() + at + kMarker.size();
+  if (std::from_chars(begin, line.data() + line.size(), n).ec != std::errc()) return std::nullopt;
+  return n;
+}
+
+bool has_axis_word(const std::string& words) {
+  return words.find_first_of("XYZAC") != std::string::npos;
+}
+
+}  // namespace
+
+bool takes_planner_block(std::string_view line) {
+  const std::string words = words_of(line);
+  return has_axis_word(words) || has_g(words, 4);
+}
+
+std::size_t first_unfinished_line(const std::vector<std::string>& program, std::size_t accepted_count,
+                                  std::size_t queued_blocks) {
+  std::size_t first = std::min(accepted_count, program.size());
+  for (std::size_t remaining = queued_blocks; remaining > 0 && first > 0;) {
+    --first;
+    if (takes_planner_block(program[first])) --remaining;
+  }
+  // Lines between a finished block and the first queued one (comments, modal lines) were
+  // already taken by the controller; the first unfinished line is the queued block itself.
+  if (queued_blocks == 0) return first;
+  while (first < accepted_count && !takes_planner_block(program[first])) ++first;
+  return first;
+}
+
+std::expected<ResumePlan, LinkError> plan_resume(const std::vector<std::string>& program, std::size_t first_unfinished,
+                                                 double safe_z_mm) {
+  if (first_unfinished > program.size())
+    return std::unexpected(LinkError{LinkErrorCode::bad_request,
+                                     fmt::format("resume at line {} of a {}-line program", first_unfinished + 1,
+                                                 program.size())});
+  ResumePlan plan;
+  std::size_t first_marker = program.size();
+  for (std::size_t i = 0; i < program.size(); ++i) {
+    const auto n = contour_marker(program[i]);
+    if (!n) continue;
+    first_marker = std::min(first_marker, i);
+    if (i <= first_unfinished) {
+      plan.restart_index = i;
+      plan.contour = *n;
+    }
+  }
+  if (first_marker == program.size() && first_unfinished > 0)
+    return std::unexpected(LinkError{LinkErrorCode::bad_request,
+                                     "the program carries no (CONTOUR …) markers: no safe point to resume from"});
+  if (plan.contour < 0) return plan;  // nothing of a contour ran yet: start over from the top
+  // The set-up the program makes before its first contour, minus motion: units, distance and
+  // feed modes. Then inverse time off (the contour may have ended in G93) and a retract.
+  for (std::size_t i = 0; i < first_marker; ++i) {
+    const std::string words = words_of(program[i]);
+    if (!words.empty() && !has_axis_word(words) && words.front() != '%' && words.front() != 'O')
+      plan.preamble.push_back(program[i]);
+  }
+  plan.preamble.push_back("G94");
+  double z = safe_z_mm;
+  for (std::size_t i = plan.restart_index + 1; i < program.size() && i < plan.restart_index + 4; ++i) {
+    const std::string words = words_of(program[i]);
+    if (has_g(words, 0)) {
+      if (auto v = word_value(words, 'Z')) z = *v;
+      break;
+    }
+  }
+  plan.preamble.push_back(fmt::format("G0Z{}", z));
+  return plan;
+}
+
+}  // namespace lamina::drivers

@@ -1,0 +1,400 @@
+#include "lamina/drivers/streamer.hpp"
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <deque>
+#include <mutex>
+#include <thread>
+
+#include <boost/asio/executor_work_guard.hpp>
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/post.hpp>
+#include <boost/asio/steady_timer.hpp>
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+namespace lamina::drivers {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+namespace asio = boost::asio;
+
+double seconds_between(Clock::time_point a, Clock::time_point b) {
+  return std::chrono::duration<double>(b - a).count();
+}
+
+// Pacing keeps at most this much program data ahead of the wire, so a real-time byte queued
+// behind it reaches the controller within it (plus one chunk).
+constexpr double kPacingBacklogS = 0.015;
+constexpr double kTickS = 0.005;
+
+}  // namespace
+
+struct Streamer::Impl {
+  TransportFactory open;
+  std::unique_ptr<LineProtocol> protocol;
+  StreamerSettings settings;
+
+  asio::io_context io;
+  asio::executor_work_guard<asio::io_context::executor_type> guard{io.get_executor()};
+  asio::steady_timer tick{io};
+  std::thread thread;
+
+  std::unique_ptr<Transport> transport;
+  std::array<std::uint8_t, 4096> read_buffer{};
+  std::string write_buffer;  // the bytes of the write in flight
+  bool writing = false;
+  std::deque<std::pair<std::string, Clock::time_point>> realtime_queue;  // ahead of program bytes
+  std::size_t realtime_in_write = 0;  // how many queued real-time requests the write carries
+  std::vector<Clock::time_point> realtime_in_write_times;
+
+  // Streaming state (io thread only, mirrored under `mutex` for progress()).
+  bool streaming = false, handshaking = false, loaded = false;
+  LineSpan pending_span;
+  LinkCallbacks callbacks;
+  Clock::time_point started{}, last_heard{}, handshake_started{}, last_status_poll{};
+  double pace_credit_bytes = 0;
+  Clock::time_point pace_last{};
+  std::size_t span_size = 0, first_index = 0;
+  bool error_lock_pending = false;
+  std::atomic<int> resets_seen{0};    // banners while not streaming (recover() waits for one)
+  int idle_with_lines_in_flight = 0;  // consecutive Idle reports while we wait for acks
+  std::size_t accepted_at_last_status = 0;
+
+  mutable std::mutex mutex;
+  std::condition_variable done_cv;
+  LinkProgress shared_progress;
+  std::optional<LinkOutcome> outcome;
+  RealtimeLatency latency;
+  double latency_sum_s = 0;
+
+  Impl(TransportFactory f, std::unique_ptr<LineProtocol> p, StreamerSettings s)
+      : open(std::move(f)), protocol(std::move(p)), settings(s) {
+    thread = std::thread([this] { io.run(); });
+  }
+  ~Impl() {
+    asio::post(io, [this] {
+      tick.cancel();
+      if (transport) transport->close();
+      guard.reset();
+    });
+    thread.join();
+  }
+
+  // ---- io thread ----
+
+  void begin(LineSpan span, LinkCallbacks cbs) {
+    callbacks = std::move(cbs);
+    {
+      std::lock_guard lock(mutex);
+      outcome.reset();
+      shared_progress = {};
+      shared_progress.lines_total = span.lines.size();
+    }
+    span_size = span.lines.size();
+    first_index = span.first_index;
+    started = last_heard = Clock::now();
+    streaming = true;
+    loaded = false;
+    if (!transport) {
+      auto opened = open(io);
+      if (!opened) return finish(opened.error());
+      transport = std::move(*opened);
+      spdlog::info("link: connected {}", transport->describe());
+      read_more();
+    }
+    pending_span = std::move(span);
+    const std::string hello = protocol->handshake_done() ? std::string() : protocol->handshake();
+    if (!hello.empty()) {
+      handshaking = true;
+      handshake_started = Clock::now();
+      send_realtime_bytes(hello);
+    } else {
+      load_pending();
+    }
+    schedule_tick();
+  }
+
+  void load_pending() {
+    handshaking = false;
+    protocol->load(std::move(pending_span));
+    loaded = true;
+    pace_last = Clock::now();
+    pace_credit_bytes = 0;
+    pump();
+  }
+
+  void finish(LinkError error) { finish(std::optional<LinkError>(std::move(error))); }
+  void finish(std::optional<LinkError> error) {
+    if (!streaming) return;
+    streaming = false;
+    if (error) {
+      protocol->halt();
+      spdlog::warn("link: stopped: {} ({})", error->message, to_string(error->code));
+    }
+    LinkOutcome o;
+    o.completed = !error;
+    o.error = std::move(error);
+    const std::size_t accepted = protocol->lines_accepted();
+    o.last_accepted_index = accepted ? first_index + accepted - 1 : first_index;
+    o.lines_accepted = accepted;
+    publish_progress();
+    {
+      std::lock_guard lock(mutex);
+      outcome = o;
+    }
+    done_cv.notify_all();
+    if (callbacks.on_done) callbacks.on_done(o);
+  }
+
+  void read_more() {
+    transport->async_read_some(read_buffer, [this](std::error_code ec, std::size_t n) {
+      if (ec) {
+        if (ec == std::errc::operation_canceled) return;
+        const std::string what = transport ? transport->describe() : std::string("link");
+        if (transport) transport->close();
+        transport.reset();
+        writing = false;
+        finish(LinkError{LinkErrorCode::io_error, fmt::format("{}: {}", what, ec.message())});
+        return;
+      }
+      last_heard = Clock::now();
+      handle(protocol->on_received(std::string_view(reinterpret_cast<const char*>(read_buffer.data()), n)));
+      if (transport) read_more();
+    });
+  }
+
+  void handle(const std::vector<ProtocolEvent>& events) {
+    for (const auto& event : events) {
+      if (const auto* s = std::get_if<StatusReceived>(&event)) {
+        {
+          std::lock_guard lock(mutex);
+          shared_progress.last_status = s->status;
+        }
+        publish_progress();  // acks that came before this report are counted in it
+        {
+          std::lock_guard lock(mutex);
+          ++shared_progress.statuses_received;
+        }
+        check_lost_acknowledgement(s->status);
+        if (callbacks.on_status) callbacks.on_status(s->status);
+      } else if (const auto* r = std::get_if<LineRejected>(&event)) {
+        // grblHAL refuses everything after an error until an empty line: the lines already in
+        // its buffer are refused (nothing moves), then the empty line clears the lock.
+        error_lock_pending = true;
+        send_realtime_bytes(protocol->clear_error_lock());
+        finish(LinkError{LinkErrorCode::controller_error,
+                         fmt::format("line {} refused: {}", r->index + 1, r->meaning)});
+      } else if (const auto* a = std::get_if<ControllerAlarm>(&event)) {
+        finish(LinkError{LinkErrorCode::controller_alarm, fmt::format("alarm {}: {}", a->code, a->meaning)});
+      } else if (const auto* reset = std::get_if<ControllerReset>(&event)) {
+        resets_seen.fetch_add(1);
+        if (streaming && loaded)
+          finish(LinkError{LinkErrorCode::controller_alarm, fmt::format("the controller reset itself ({})", reset->text)});
+      } else if (const auto* info = std::get_if<ControllerInfo>(&event)) {
+        std::lock_guard lock(mutex);
+        if (info->planner_blocks) shared_progress.planner_blocks = info->planner_blocks;
+        if (info->rx_buffer_bytes) shared_progress.rx_buffer_bytes = info->rx_buffer_bytes;
+      } else if (const auto* v = std::get_if<ProtocolViolation>(&event)) {
+        finish(LinkError{LinkErrorCode::protocol_error, v->what});
+      }
+    }
+    if (handshaking && protocol->handshake_done()) load_pending();
+    if (streaming && loaded && protocol->finished()) finish(std::nullopt);
+    publish_progress();
+    pump();
+  }
+
+  // A controller acknowledges a line when it takes it into its queue, long before it runs it.
+  // Idle in two reports in a row (asked after our last line went out, with no ack between)
+  // while we still wait for acks means an ok was lost or a line never arrived whole.
+  void check_lost_acknowledgement(const ControllerStatus& status) {
+    const std::size_t accepted = protocol->lines_accepted();
+    const std::size_t waiting = protocol->lines_sent() - accepted;
+    if (!streaming || !loaded || waiting == 0 || status.state != ControllerState::idle ||
+        accepted != accepted_at_last_status) {
+      idle_with_lines_in_flight = 0;
+      accepted_at_last_status = accepted;
+      return;
+    }
+    if (++idle_with_lines_in_flight >= 3)
+      finish(LinkError{LinkErrorCode::protocol_error,
+                       fmt::format("acknowledgement lost: the controller is idle with {} line(s) unacknowledged "
+                                   "(from line {})", waiting, first_index + accepted + 1)});
+  }
+
+  void send_realtime_bytes(std::string bytes) {
+    if (bytes.empty()) return;
+    realtime_queue.emplace_back(std::move(bytes), Clock::now());
+    pump();
+  }
+
+  // One write at a time: queued real-time bytes first, then paced program bytes.
+  void pump() {
+    if (writing || !transport) return;
+    write_buffer.clear();
+    realtime_in_write_times.clear();
+    while (!realtime_queue.empty()) {
+      write_buffer += realtime_queue.front().first;
+      realtime_in_write_times.push_back(realtime_queue.front().second);
+      realtime_queue.pop_front();
+    }
+    if (streaming && loaded) write_buffer += paced_program_bytes();
+    if (write_buffer.empty()) return;
+    writing = true;
+    transport->async_write(std::span(reinterpret_cast<const std::uint8_t*>(write_buffer.data()), write_buffer.size()),
+                           [this](std::error_code ec, std::size_t n) {
+                             writing = false;
+                             const auto now = Clock::now();
+                             for (auto t : realtime_in_write_times) record_latency(seconds_between(t, now));
+                             if (ec) {
+                               if (ec == std::errc::operation_canceled) return;
+                               finish(LinkError{LinkErrorCode::io_error, fmt::format("write: {}", ec.message())});
+                               return;
+                             }
+                             {
+                               std::lock_guard lock(mutex);
+                               shared_progress.bytes_sent += n;
+                             }
+                             pump();
+                           });
+  }
+
+  std::string paced_program_bytes() {
+    if (settings.pace_bytes_per_s <= 0) return protocol->take_sendable();
+    const auto now = Clock::now();
+    pace_credit_bytes = std::min(settings.pace_bytes_per_s * kPacingBacklogS,
+                                 pace_credit_bytes + seconds_between(pace_last, now) * settings.pace_bytes_per_s);
+    pace_last = now;
+    if (pace_credit_bytes < 1) return {};
+    // take_sendable hands out whole lines (or a chunk); let the credit go negative by one line
+    // rather than split it: the backlog bound is then credit + one line.
+    std::string bytes = protocol->take_sendable();
+    pace_credit_bytes -= static_cast<double>(bytes.size());
+    return bytes;
+  }
+
+  void record_latency(double s) {
+    std::lock_guard lock(mutex);
+    latency.max_s = std::max(latency.max_s, s);
+    latency_sum_s += s;
+    ++latency.count;
+    latency.mean_s = latency_sum_s / static_cast<double>(latency.count);
+  }
+
+  void publish_progress() {
+    std::lock_guard lock(mutex);
+    shared_progress.lines_sent = protocol->lines_sent();
+    shared_progress.lines_accepted = protocol->lines_accepted();
+    shared_progress.seconds = seconds_between(started, Clock::now());
+  }
+
+  void schedule_tick() {
+    tick.expires_after(std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(kTickS)));
+    tick.async_wait([this](boost::system::error_code ec) {
+      if (ec) return;
+      on_tick();
+      if (transport || streaming) schedule_tick();  // status keeps coming between jobs
+    });
+  }
+
+  void on_tick() {
+    const auto now = Clock::now();
+    if (handshaking && seconds_between(handshake_started, now) > settings.handshake_timeout_s) {
+      finish(LinkError{LinkErrorCode::timeout,
+                       fmt::format("{}: no answer to the handshake within {} s",
+                                   transport ? transport->describe() : "link", settings.handshake_timeout_s)});
+      return;
+    }
+    if (settings.status_period_s > 0 && seconds_between(last_status_poll, now) >= settings.status_period_s) {
+      last_status_poll = now;
+      send_realtime_bytes(protocol->realtime(RealtimeCommand::status));
+    }
+    const bool in_flight = protocol->lines_sent() > protocol->lines_accepted();
+    if (streaming && loaded && in_flight && seconds_between(last_heard, now) > settings.silence_timeout_s) {
+      finish(LinkError{LinkErrorCode::timeout,
+                       fmt::format("nothing heard for {} s with {} line(s) in flight", settings.silence_timeout_s,
+                                   protocol->lines_sent() - protocol->lines_accepted())});
+      return;
+    }
+    if (callbacks.on_progress) {
+      LinkProgress p;
+      {
+        std::lock_guard lock(mutex);
+        p = shared_progress;
+      }
+      callbacks.on_progress(p);
+    }
+    pump();
+  }
+};
+
+Streamer::Streamer(TransportFactory open, std::unique_ptr<LineProtocol> protocol, StreamerSettings settings)
+    : impl_(std::make_unique<Impl>(std::move(open), std::move(protocol), settings)) {}
+
+Streamer::~Streamer() = default;
+
+void Streamer::start(LineSpan span, LinkCallbacks callbacks) {
+  {
+    std::lock_guard lock(impl_->mutex);  // so a wait() right after this waits for this run
+    impl_->outcome.reset();
+  }
+  asio::post(impl_->io, [impl = impl_.get(), span = std::move(span), callbacks = std::move(callbacks)]() mutable {
+    impl->begin(std::move(span), std::move(callbacks));
+  });
+}
+
+void Streamer::request(RealtimeCommand command) {
+  const auto requested = Clock::now();
+  asio::post(impl_->io, [impl = impl_.get(), command, requested] {
+    std::string bytes = impl->protocol->realtime(command);
+    if (bytes.empty()) return;
+    impl->realtime_queue.emplace_back(std::move(bytes), requested);
+    impl->pump();
+  });
+}
+
+void Streamer::stop(LinkError why) {
+  asio::post(impl_->io, [impl = impl_.get(), why = std::move(why)]() mutable { impl->finish(std::move(why)); });
+}
+
+LinkProgress Streamer::progress() const {
+  std::lock_guard lock(impl_->mutex);
+  return impl_->shared_progress;
+}
+
+std::optional<LinkOutcome> Streamer::wait(double timeout_s) {
+  std::unique_lock lock(impl_->mutex);
+  if (!impl_->done_cv.wait_for(lock, std::chrono::duration<double>(timeout_s), [&] { return impl_->outcome.has_value(); }))
+    return std::nullopt;
+  return impl_->outcome;
+}
+
+std::optional<LinkError> Streamer::recover(double timeout_s) {
+  const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(timeout_s));
+  const std::string reset = impl_->protocol->realtime(RealtimeCommand::reset);
+  if (!reset.empty()) {
+    const int before = impl_->resets_seen.load();
+    request(RealtimeCommand::reset);
+    // The controller answers a reset with its banner; give it until the deadline.
+    while (impl_->resets_seen.load() == before && Clock::now() < deadline)
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    if (impl_->resets_seen.load() == before)
+      return LinkError{LinkErrorCode::timeout, "no banner after the soft reset"};
+  }
+  const auto unlock = impl_->protocol->unlock_lines();
+  if (unlock.empty()) return std::nullopt;
+  start(LineSpan{unlock, 0}, {});
+  const double left_s = std::max(0.1, std::chrono::duration<double>(deadline - Clock::now()).count());
+  const auto outcome = wait(left_s);
+  if (!outcome) return LinkError{LinkErrorCode::timeout, "no answer to the unlock"};
+  return outcome->error;
+}
+
+RealtimeLatency Streamer::realtime_latency() const {
+  std::lock_guard lock(impl_->mutex);
+  return impl_->latency;
+}
+
+}  // namespace lamina::drivers
