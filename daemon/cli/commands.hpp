@@ -7,5 +7,7 @@ namespace lamina::cli {
 void add_check_command(CLI::App& app, int& exit_code);
 void add_slice_command(CLI::App& app, int& exit_code);
 void add_plan_command(CLI::App& app, int& exit_code);
+void add_ports_command(CLI::App& app, int& exit_code);
+void add_stream_command(CLI::App& app, int& exit_code);
 
 }  // namespace lamina::cli

@@ -1,4 +1,5 @@
-// lamina: the command-line tool. Offline commands work on a model file directly.
+// lamina: the command-line tool. Offline commands work on a model file directly; ports and
+// stream talk to the machine through drivers/.
 #include "commands.hpp"
 
 int main(int argc, char** argv) {
@@ -8,6 +9,8 @@ int main(int argc, char** argv) {
   lamina::cli::add_check_command(app, exit_code);
   lamina::cli::add_slice_command(app, exit_code);
   lamina::cli::add_plan_command(app, exit_code);
+  lamina::cli::add_ports_command(app, exit_code);
+  lamina::cli::add_stream_command(app, exit_code);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

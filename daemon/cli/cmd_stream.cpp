@@ -1,0 +1,191 @@
+// lamina stream: send a program to the CNC through the machine link, with the cell's PLC
+// minding the pump and interlocks when --modbus is given. Progress on stderr, the keyboard holds
+// (h or space), resumes (r) and aborts (q); a stopped cut is resumed only when the operator says
+// so, from the start of the contour it was cutting.
+#include <termios.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <fstream>
+#include <thread>
+
+#include <boost/asio/io_context.hpp>
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "commands.hpp"
+#include "lamina/drivers/cell_io.hpp"
+#include "lamina/drivers/cut_job.hpp"
+#include "lamina/drivers/modbus_block_link.hpp"
+#include "lamina/drivers/streamer.hpp"
+#include "stream_terminal.hpp"
+
+namespace lamina::cli {
+namespace {
+
+struct StreamOptions {
+  std::string program;
+  std::string port, tcp, modbus;
+  std::string protocol = "grbl";
+  int baud = 115200;
+  std::size_t rx_buffer = 0;
+  double status_hz = 5;
+  bool json = false;
+  bool resume = false;  // resume automatically after a stop? never: only the keyboard's R
+};
+
+std::pair<std::string, int> split_host_port(const std::string& text, const char* flag) {
+  const auto colon = text.rfind(':');
+  if (colon == std::string::npos) throw CLI::ValidationError(flag, fmt::format("'{}': expected HOST:PORT", text));
+  try {
+    return {text.substr(0, colon), std::stoi(text.substr(colon + 1))};
+  } catch (const std::exception&) {
+    throw CLI::ValidationError(flag, fmt::format("'{}': the port is not a number", text));
+  }
+}
+
+std::expected<std::vector<std::string>, std::string> read_program(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) return std::unexpected(fmt::format("cannot read {}", path));
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(in, line);) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (!line.empty()) lines.push_back(line);  // a blank line means nothing to a controller
+  }
+  if (lines.empty()) return std::unexpected(fmt::format("{}: no program lines", path));
+  return lines;
+}
+
+std::atomic<bool> g_interrupted{false};
+extern "C" void on_sigint(int) { g_interrupted = true; }
+
+int run_stream(const StreamOptions& o) {
+  auto program = read_program(o.program);
+  if (!program) {
+    fmt::print(stderr, "lamina stream: {}\n", program.error());
+    return 1;
+  }
+  std::unique_ptr<drivers::MachineLink> link;
+  std::unique_ptr<drivers::CellIo> cell;
+  double line_bytes_per_s = 0;
+  if (o.protocol == "modbus") {
+    if (o.modbus.empty()) {
+      fmt::print(stderr, "lamina stream: --protocol modbus needs --modbus HOST:PORT\n");
+      return 2;
+    }
+    drivers::ModbusBlockSettings s;
+    std::tie(s.host, s.port) = split_host_port(o.modbus, "--modbus");
+    s.status_period_s = 1.0 / o.status_hz;
+    link = std::make_unique<drivers::ModbusBlockLink>(s);
+  } else {
+    if (o.port.empty() == o.tcp.empty()) {
+      fmt::print(stderr, "lamina stream: give --port DEVICE or --tcp HOST:PORT\n");
+      return 2;
+    }
+    std::unique_ptr<drivers::LineProtocol> protocol;
+    if (o.protocol == "grbl") protocol = drivers::make_grbl_protocol({o.rx_buffer});
+    else if (o.protocol == "send-response") protocol = drivers::make_send_response_protocol();
+    else protocol = drivers::make_xonxoff_protocol();
+    drivers::StreamerSettings settings;
+    settings.status_period_s = o.protocol == "xonxoff" ? 0 : 1.0 / o.status_hz;
+    drivers::TransportFactory open;
+    if (!o.port.empty()) {
+      drivers::SerialSettings serial;
+      serial.baud = o.baud;
+      line_bytes_per_s = o.baud / 10.0;  // 8N1
+      settings.pace_bytes_per_s = line_bytes_per_s;
+      open = [port = o.port, serial](boost::asio::io_context& io) { return drivers::open_serial(io, port, serial); };
+    } else {
+      const auto [host, port] = split_host_port(o.tcp, "--tcp");
+      open = [host, port](boost::asio::io_context& io) { return drivers::open_tcp(io, host, port); };
+    }
+    link = std::make_unique<drivers::Streamer>(std::move(open), std::move(protocol), settings);
+    if (!o.modbus.empty()) {
+      drivers::CellIoSettings cs;
+      std::tie(cs.host, cs.port) = split_host_port(o.modbus, "--modbus");
+      cell = std::make_unique<drivers::CellIo>(cs);
+    }
+  }
+
+  drivers::CutJob job(*link, cell.get(), *program);
+  KeyboardControl keys;  // raw stdin while streaming when it is a terminal
+  ProgressLine progress(program->size(), !o.json);
+  std::signal(SIGINT, on_sigint);
+  std::atomic<bool> finished{false};
+  std::thread watcher([&] {
+    while (!finished) {
+      if (g_interrupted.exchange(false)) job.abort("interrupted (Ctrl-C)");
+      switch (keys.poll()) {
+        case Key::hold: job.hold(); break;
+        case Key::resume: job.continue_motion(); break;
+        case Key::quit: job.abort("aborted from the keyboard"); break;
+        case Key::none: break;
+      }
+      progress.update(job.report());
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    }
+  });
+  drivers::CutReport report = job.run();
+  while (report.state == drivers::CutState::stopped && keys.interactive()) {
+    progress.clear();
+    fmt::print(stderr, "\nstopped: {}\n", report.reason ? report.reason->message : "?");
+    if (report.resume)
+      fmt::print(stderr, "press R to resume at line {} (contour {}), Q to quit\n", report.resume->restart_index + 1,
+                 report.resume->contour);
+    if (!report.resume || keys.wait_resume_or_quit() != Key::resume) break;
+    report = job.resume();
+  }
+  finished = true;
+  watcher.join();
+  progress.clear();
+
+  const double utilisation = line_bytes_per_s > 0 && report.seconds > 0
+                                 ? static_cast<double>(report.bytes_sent) / (report.seconds * line_bytes_per_s)
+                                 : 0;
+  if (o.json) {
+    nlohmann::json j{{"state", drivers::to_string(report.state)},
+                     {"lines", report.lines_total},
+                     {"lines_accepted", report.lines_accepted},
+                     {"bytes", report.bytes_sent},
+                     {"seconds", report.seconds},
+                     {"link_utilisation", utilisation},
+                     {"first_unfinished_line", report.first_unfinished_line + 1}};
+    if (report.reason) j["reason"] = {{"code", drivers::to_string(report.reason->code)}, {"message", report.reason->message}};
+    if (report.resume) j["resume"] = {{"line", report.resume->restart_index + 1}, {"contour", report.resume->contour}};
+    if (auto* s = dynamic_cast<drivers::Streamer*>(link.get())) {
+      const auto l = s->realtime_latency();
+      j["realtime_latency_ms"] = {{"max", l.max_s * 1e3}, {"mean", l.mean_s * 1e3}, {"count", l.count}};
+    }
+    fmt::print("{}\n", j.dump());
+  } else {
+    fmt::print("{}: {} of {} lines, {} bytes in {:.1f} s", drivers::to_string(report.state), report.lines_accepted,
+               report.lines_total, report.bytes_sent, report.seconds);
+    if (utilisation > 0) fmt::print(", link {:.0f} % busy", 100 * utilisation);
+    fmt::print("\n");
+    if (report.reason) fmt::print("reason: {}\n", report.reason->message);
+  }
+  return report.state == drivers::CutState::completed ? 0 : 1;
+}
+
+}  // namespace
+
+void add_stream_command(CLI::App& app, int& exit_code) {
+  auto o = std::make_shared<StreamOptions>();
+  auto* cmd = app.add_subcommand("stream", "send a program to the CNC (character counting, send-response, XON/XOFF "
+                                           "or the PLC's Modbus mailbox) with the cell's interlocks watched");
+  cmd->add_option("program", o->program, "G-code file")->required();
+  cmd->add_option("--port", o->port, "serial device or USB serial number (see lamina ports)");
+  cmd->add_option("--tcp", o->tcp, "the controller's TCP stream, HOST:PORT");
+  cmd->add_option("--protocol", o->protocol, "grbl | send-response | xonxoff | modbus")
+      ->check(CLI::IsMember({"grbl", "send-response", "xonxoff", "modbus"}));
+  cmd->add_option("--baud", o->baud, "serial speed (8N1)")->check(CLI::Range(300, 4000000));
+  cmd->add_option("--rx-buffer", o->rx_buffer, "the controller's receive buffer (default: as it reports)");
+  cmd->add_option("--modbus", o->modbus, "the cell PLC, HOST:PORT (and the mailbox for --protocol modbus)");
+  cmd->add_option("--status-hz", o->status_hz, "status polls per second")->check(CLI::Range(0.5, 50.0));
+  cmd->add_flag("--json", o->json, "print the summary as JSON (no progress bar)");
+  cmd->callback([o, &exit_code] { exit_code = run_stream(*o); });
+}
+
+}  // namespace lamina::cli
