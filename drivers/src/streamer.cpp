@@ -53,7 +53,7 @@ struct Streamer::Impl {
   bool streaming = false, handshaking = false, loaded = false;
   LineSpan pending_span;
   LinkCallbacks callbacks;
-  Clock::time_point started{}, last_heard{}, handshake_started{}, last_status_poll{};
+  Clock::time_point started{}, last_heard{}, handshake_started{}, last_status_poll{}, flow_running_since{};
   double pace_credit_bytes = 0;
   Clock::time_point pace_last{};
   std::size_t span_size = 0, first_index = 0;
@@ -94,7 +94,7 @@ struct Streamer::Impl {
     }
     span_size = span.lines.size();
     first_index = span.first_index;
-    started = last_heard = Clock::now();
+    started = last_heard = flow_running_since = Clock::now();
     streaming = true;
     loaded = false;
     if (!transport) {
@@ -218,7 +218,18 @@ struct Streamer::Impl {
       accepted_at_last_status = accepted;
       return;
     }
-    if (++idle_with_lines_in_flight >= 3)
+    if (++idle_with_lines_in_flight < 3) return;
+    int rx_size = 0;
+    {
+      std::lock_guard lock(mutex);
+      rx_size = shared_progress.rx_buffer_bytes.value_or(0);
+    }
+    if (status.rx_bytes_free && rx_size > 0 && *status.rx_bytes_free < rx_size)
+      finish(LinkError{LinkErrorCode::timeout,
+                       fmt::format("the controller stalled: idle with {} byte(s) left in its receive buffer and {} "
+                                   "line(s) unacknowledged (from line {})",
+                                   rx_size - *status.rx_bytes_free, waiting, first_index + accepted + 1)});
+    else
       finish(LinkError{LinkErrorCode::protocol_error,
                        fmt::format("acknowledgement lost: the controller is idle with {} line(s) unacknowledged "
                                    "(from line {})", waiting, first_index + accepted + 1)});
@@ -310,6 +321,12 @@ struct Streamer::Impl {
     if (settings.status_period_s > 0 && seconds_between(last_status_poll, now) >= settings.status_period_s) {
       last_status_poll = now;
       send_realtime_bytes(protocol->realtime(RealtimeCommand::status));
+    }
+    if (!protocol->flow_stopped()) flow_running_since = now;
+    if (streaming && loaded && seconds_between(flow_running_since, now) > settings.silence_timeout_s) {
+      finish(LinkError{LinkErrorCode::timeout, fmt::format("the controller has held the line (XOFF) for {} s",
+                                                           settings.silence_timeout_s)});
+      return;
     }
     const bool in_flight = protocol->lines_sent() > protocol->lines_accepted();
     if (streaming && loaded && in_flight && seconds_between(last_heard, now) > settings.silence_timeout_s) {

@@ -84,6 +84,9 @@ class LineProtocol {
   // span of their own by MachineLink::recover().
   virtual std::vector<std::string> unlock_lines() const { return {}; }
 
+  // True while the controller has told us to stop sending (XON/XOFF's DC3).
+  virtual bool flow_stopped() const { return false; }
+
   virtual std::size_t lines_sent() const = 0;      // of the loaded span
   virtual std::size_t lines_accepted() const = 0;  // acknowledged (or, for XON/XOFF, written)
   virtual bool finished() const = 0;               // every loaded line accepted
