@@ -1,0 +1,119 @@
+// A stopped cut waits for the operator; resume() restarts at the start of the contour that was
+// being cut, so every finished contour runs exactly once and the program completes.
+#include <gtest/gtest.h>
+
+#include <thread>
+
+#include "lamina/drivers/cut_job.hpp"
+#include "lamina/drivers/streamer.hpp"
+#include "link_test_support.hpp"
+
+namespace lamina::drivers::testing {
+namespace {
+
+struct Record {
+  std::string line;
+  bool completed;
+};
+
+std::vector<Record> records(const std::string& log) {
+  std::vector<Record> out;
+  for (const auto& r : sim::testing::executed_blocks(sim::testing::read_log(log)))
+    out.push_back({r["line"], r.value("completed", true)});
+  return out;
+}
+
+std::size_t contour_start_at_or_before(const std::vector<std::string>& program, std::size_t index) {
+  std::size_t start = 0;
+  for (std::size_t i = 0; i <= index && i < program.size(); ++i)
+    if (program[i].rfind("(CONTOUR ", 0) == 0) start = i;
+  return start;
+}
+
+// The log of a run that stopped once and was resumed: the first run's blocks, the resume
+// preamble (…, "G94", "G0Z10"), then the program from the restart line to its end.
+void expect_resumed_once_from_contour_start(const std::vector<Record>& log, const std::vector<std::string>& program,
+                                            std::size_t restart) {
+  std::size_t preamble = log.size();
+  for (std::size_t i = 0; i + 1 < log.size(); ++i)
+    if (log[i].line == "G94" && log[i + 1].line.rfind("G0Z", 0) == 0) preamble = i;
+  ASSERT_LT(preamble, log.size()) << "no resume preamble in the log";
+  ASSERT_GE(preamble, 1u);
+  // First run: the program in order; the lines that completed end where the stop came.
+  std::size_t done = 0;
+  for (std::size_t i = 0; i + 1 < preamble; ++i) {
+    ASSERT_EQ(log[i].line, program[i]) << "first run, block " << i + 1;
+    if (log[i].completed) done = i + 1;
+  }
+  EXPECT_EQ(log[preamble - 1].line, "G21G90G94G17") << "the program's modal set-up starts the preamble";
+  // Restart at the start of the contour holding the first line that had not finished.
+  EXPECT_EQ(restart, contour_start_at_or_before(program, done)) << "first unfinished line " << done + 1;
+  const std::size_t after = preamble + 2;
+  ASSERT_EQ(log.size() - after, program.size() - restart);
+  for (std::size_t i = 0; i < program.size() - restart; ++i) {
+    EXPECT_EQ(log[after + i].line, program[restart + i]) << "resumed block " << i + 1;
+    EXPECT_TRUE(log[after + i].completed);
+  }
+  // No contour that had finished runs twice: the resumed part begins inside the stopped one.
+  EXPECT_GT(done, restart - 1);
+}
+
+std::unique_ptr<Streamer> pty_link(const std::string& path) {
+  StreamerSettings settings;
+  settings.pace_bytes_per_s = 11520;
+  return std::make_unique<Streamer>(
+      [path](boost::asio::io_context& io) { return open_serial(io, path, SerialSettings{}); }, make_grbl_protocol(),
+      settings);
+}
+
+TEST(CutJobResume, AfterAnAlarmOnlyTheOperatorResumesFromTheContourStart) {
+  TempDir dir;
+  const auto program = contour_program(4, 100);
+  SimProcess sim({"--link", dir.file("cnc"), "--log", dir.file("exec.jsonl"), "--control", "127.0.0.1:0",
+                  "--alarm-at-line", "260", "--time-scale", "4"});
+  auto link = pty_link(dir.file("cnc"));
+  CutJob job(*link, nullptr, program);
+  CutReport r = job.run();
+  ASSERT_EQ(r.state, CutState::stopped);
+  ASSERT_TRUE(r.reason);
+  EXPECT_EQ(r.reason->code, LinkErrorCode::controller_alarm) << r.reason->message;
+  ASSERT_TRUE(r.resume);
+  // Nothing happens until the operator says so.
+  const auto before = records(dir.file("exec.jsonl")).size();
+  std::this_thread::sleep_for(std::chrono::seconds(1));
+  EXPECT_EQ(records(dir.file("exec.jsonl")).size(), before);
+  EXPECT_EQ(job.report().state, CutState::stopped);
+
+  const std::size_t restart = r.resume->restart_index;
+  r = job.resume();
+  ASSERT_EQ(r.state, CutState::completed) << (r.reason ? r.reason->message : "");
+  expect_resumed_once_from_contour_start(records(dir.file("exec.jsonl")), program, restart);
+}
+
+TEST(CutJobResume, AfterAFeedHoldStopTheQueueTellsExactlyWhatRan) {
+  TempDir dir;
+  const auto program = contour_program(4, 100);
+  SimProcess sim({"--link", dir.file("cnc"), "--log", dir.file("exec.jsonl"), "--control", "127.0.0.1:0",
+                  "--time-scale", "2"});
+  auto link = pty_link(dir.file("cnc"));
+  CutJob job(*link, nullptr, program);
+  std::thread stopper([&] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(2500));  // well into the second contour
+    job.abort("operator stop");
+  });
+  CutReport r = job.run();
+  stopper.join();
+  ASSERT_EQ(r.state, CutState::stopped);
+  EXPECT_EQ(r.reason->code, LinkErrorCode::cancelled);
+  ASSERT_TRUE(r.last_status);
+  EXPECT_EQ(r.last_status->state, ControllerState::hold) << "held with its queue intact";
+  ASSERT_TRUE(r.resume);
+  const std::size_t restart = r.resume->restart_index;
+  EXPECT_GT(restart, 0u);
+  r = job.resume();
+  ASSERT_EQ(r.state, CutState::completed) << (r.reason ? r.reason->message : "");
+  expect_resumed_once_from_contour_start(records(dir.file("exec.jsonl")), program, restart);
+}
+
+}  // namespace
+}  // namespace lamina::drivers::testing

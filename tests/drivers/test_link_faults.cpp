@@ -1,0 +1,84 @@
+// Every fault lamina-sim injects stops `lamina stream` in a safe state with a clear reason,
+// within a bounded time, and nothing resumes by itself: the jet is off (PLC), the axes stand
+// still, and the summary names where an operator may resume.
+#include <gtest/gtest.h>
+
+#include <modbus/modbus.h>
+
+#include <cctype>
+#include <chrono>
+#include <set>
+#include <thread>
+
+#include "link_test_support.hpp"
+
+namespace lamina::drivers::testing {
+namespace {
+
+struct FaultCase {
+  const char* name;
+  std::vector<std::string> sim_flags;
+  std::set<std::string> reasons;  // acceptable reason codes
+  const char* message_has;        // a word the reason's message must carry
+};
+
+void PrintTo(const FaultCase& c, std::ostream* os) { *os << c.name; }
+
+class LinkFault : public ::testing::TestWithParam<FaultCase> {};
+
+int plc_bit(int port, int address) {
+  modbus_t* ctx = modbus_new_tcp("127.0.0.1", port);
+  uint8_t bit = 0xFF;
+  if (modbus_connect(ctx) == 0) modbus_read_input_bits(ctx, address, 1, &bit);
+  modbus_close(ctx);
+  modbus_free(ctx);
+  return bit;
+}
+
+TEST_P(LinkFault, StopsSafelyWithAReasonAndDoesNotResume) {
+  const FaultCase& c = GetParam();
+  TempDir dir;
+  const auto program = contour_program(4, 150);
+  std::vector<std::string> args{"--link", dir.file("cnc"), "--log", dir.file("exec.jsonl"), "--modbus", "127.0.0.1:0",
+                                "--control", "127.0.0.1:0", "--pressure-ramp", "0.2", "--time-scale", "2"};
+  args.insert(args.end(), c.sim_flags.begin(), c.sim_flags.end());
+  SimProcess sim(args);
+  const auto t0 = std::chrono::steady_clock::now();
+  const CliRun run = run_lamina_stream(fmt::format("'{}' --port '{}' --protocol grbl --modbus 127.0.0.1:{}",
+                                                   write_program(dir, program), dir.file("cnc"), sim.modbus_port()));
+  const double took_s = sim::testing::seconds_since(t0);
+  EXPECT_EQ(run.exit_code, 1) << run.output;
+  ASSERT_EQ(run.summary["state"], "stopped") << run.output;
+  const std::string code = run.summary["reason"]["code"];
+  const std::string message = run.summary["reason"]["message"];
+  EXPECT_TRUE(c.reasons.count(code)) << "reason " << code << ": " << message;
+  std::string lower = message;
+  for (auto& ch : lower) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+  EXPECT_NE(lower.find(c.message_has), std::string::npos) << message;
+  EXPECT_TRUE(run.summary.contains("resume")) << "a stopped cut names its resume point: " << run.output;
+  EXPECT_LT(took_s, 30) << "bounded";
+  // Safe: jet off through the PLC, and the axes stand still from now on.
+  EXPECT_EQ(plc_bit(sim.modbus_port(), 3), 0) << "jet_is_on";
+  const auto before = executed_lines(dir.file("exec.jsonl"), false).size();
+  const auto a = sim::testing::control_status(sim.control_port());
+  std::this_thread::sleep_for(std::chrono::milliseconds(700));
+  const auto b = sim::testing::control_status(sim.control_port());
+  EXPECT_EQ(a["position"], b["position"]) << "the machine moved after the stop";
+  EXPECT_EQ(executed_lines(dir.file("exec.jsonl"), false).size(), before) << "nothing ran after the stop";
+  EXPECT_LT(executed_lines(dir.file("exec.jsonl")).size(), program.size());
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    EveryInjectedFault, LinkFault,
+    ::testing::Values(
+        FaultCase{"garbled_bytes", {"--garble", "0.003", "--seed", "3"}, {"controller_error", "protocol_error", "timeout", "controller_alarm"}, ""},
+        FaultCase{"lost_ok", {"--drop-ok", "120"}, {"protocol_error"}, "acknowledgement lost"},
+        FaultCase{"unplugged", {"--unplug-at-line", "200"}, {"io_error"}, "cnc"},
+        FaultCase{"alarm", {"--alarm-at-line", "150"}, {"controller_alarm"}, "alarm 1"},
+        FaultCase{"estop", {"--estop-at", "1.5"}, {"interlock", "controller_alarm"}, "stop"},
+        FaultCase{"pressure_drop", {"--pressure-drop-at", "1.5"}, {"interlock"}, "pressure"},
+        FaultCase{"stall", {"--stall-at", "1.5", "--stall-for", "4000"}, {"timeout"}, "stalled"}),
+    [](const ::testing::TestParamInfo<FaultCase>& info) { return std::string(info.param.name); });
+
+}  // namespace
+}  // namespace lamina::drivers::testing
