@@ -1,0 +1,253 @@
+// Transports against the lamina-sim process: a PTY through termios (as libserialport 0.1.1
+// refuses PTYs), TCP, and the failures a cell meets — no such port, refused or silent hosts, an
+// unplugged cable, and a close() while a read is pending.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <chrono>
+#include <string>
+
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/ip/tcp.hpp>
+
+#include "lamina/drivers/transport.hpp"
+#include "sim_process.hpp"
+
+namespace {
+
+using namespace lamina::drivers;
+using lamina::sim::testing::control;
+using lamina::sim::testing::control_status;
+using lamina::sim::testing::seconds_since;
+using lamina::sim::testing::SimProcess;
+using lamina::sim::testing::TempDir;
+
+// Keeps one read pending and collects what arrives; the handler refers to this object, so it is
+// declared after the transport (destroyed first, and the io_context never runs again by then).
+class Reader {
+ public:
+  Reader(boost::asio::io_context& io, Transport& transport) : io_(io), transport_(transport) {}
+
+  // Runs the io_context in short slices until `text` was read, the link failed, or time is up.
+  bool wait_for(const std::string& text, double wait_s) {
+    return run_until([&] { return text_.find(text) != std::string::npos; }, wait_s);
+  }
+  // Until the pending read completes with an error.
+  bool wait_for_error(double wait_s) {
+    return run_until([&] { return static_cast<bool>(error_); }, wait_s);
+  }
+  void start() {
+    if (pending_ || error_) return;
+    pending_ = true;
+    transport_.async_read_some(buffer_, [this](std::error_code ec, std::size_t n) {
+      pending_ = false;
+      if (ec) error_ = ec;
+      else text_.append(reinterpret_cast<const char*>(buffer_.data()), n);
+    });
+  }
+  const std::string& text() const { return text_; }
+  std::error_code error() const { return error_; }
+  bool pending() const { return pending_; }
+
+ private:
+  template <class Done>
+  bool run_until(Done done, double wait_s) {
+    const auto t0 = std::chrono::steady_clock::now();
+    while (!done() && seconds_since(t0) < wait_s) {
+      start();
+      io_.restart();
+      io_.run_for(std::chrono::milliseconds(20));
+      if (error_ && !done()) return false;
+    }
+    return done();
+  }
+
+  boost::asio::io_context& io_;
+  Transport& transport_;
+  std::array<std::uint8_t, 256> buffer_{};
+  std::string text_;
+  std::error_code error_;
+  bool pending_ = false;
+};
+
+// Writes `text` and runs the io_context until the write handler has run.
+std::error_code write_all(boost::asio::io_context& io, Transport& t, const std::string& text) {
+  std::optional<std::error_code> done;
+  t.async_write({reinterpret_cast<const std::uint8_t*>(text.data()), text.size()},
+                [&](std::error_code ec, std::size_t) { done = ec; });
+  const auto t0 = std::chrono::steady_clock::now();
+  while (!done && seconds_since(t0) < 3.0) {
+    io.restart();
+    io.run_for(std::chrono::milliseconds(20));
+  }
+  return done.value_or(std::make_error_code(std::errc::timed_out));
+}
+
+// A port nobody listens on: bind one, note it, let it go.
+int closed_tcp_port() {
+  boost::asio::io_context io;
+  boost::asio::ip::tcp::acceptor a(io, {boost::asio::ip::make_address("127.0.0.1"), 0});
+  return a.local_endpoint().port();
+}
+
+struct PtySim {
+  TempDir dir;
+  std::string link = dir.file("cnc");
+  SimProcess sim;
+  explicit PtySim(std::vector<std::string> extra = {})
+      : sim([&] {
+          std::vector<std::string> args{"--link", link, "--control", "127.0.0.1:0"};
+          args.insert(args.end(), extra.begin(), extra.end());
+          return args;
+        }()) {}
+};
+
+TEST(Transports, ListSerialPortsReturnsWithoutError) {
+  const auto ports = list_serial_ports();
+  ASSERT_TRUE(ports) << ports.error().message;
+  for (const auto& p : *ports) {
+    EXPECT_FALSE(p.name.empty());
+    EXPECT_FALSE(p.transport.empty()) << p.name;
+  }
+}
+
+TEST(Transports, PtyLinkReadsTheBannerAndAnswersBuildInfoOverARawLine) {
+  PtySim s;
+  boost::asio::io_context io;
+  auto t = open_serial(io, s.link, SerialSettings{});
+  ASSERT_TRUE(t) << t.error().message;
+  EXPECT_EQ((*t)->describe(), "pty " + s.link + " (termios) 115200 8N1");
+  Reader r(io, **t);
+  ASSERT_TRUE(r.wait_for("Grbl", 3.0)) << "got: " << r.text() << " error: " << r.error().message();
+  ASSERT_FALSE(write_all(io, **t, "$I\n"));
+  ASSERT_TRUE(r.wait_for("[OPT:", 3.0)) << "got: " << r.text();
+  EXPECT_TRUE(r.wait_for("ok", 2.0));
+  // A line that echoed would hand the banner back to the controller: it must see our 3 bytes only.
+  const auto status = control_status(s.sim.control_port());
+  EXPECT_EQ(status["bytes_received"], 3) << status.dump();
+  EXPECT_EQ(status["errors_sent"], 0) << status.dump();
+}
+
+TEST(Transports, TcpLinkReadsTheBannerAndAnswersBuildInfo) {
+  SimProcess sim({"--tcp", "127.0.0.1:0"});
+  boost::asio::io_context io;
+  auto t = open_tcp(io, "127.0.0.1", sim.tcp_port(), 2.0);
+  ASSERT_TRUE(t) << t.error().message;
+  EXPECT_EQ((*t)->describe(), "tcp 127.0.0.1:" + std::to_string(sim.tcp_port()));
+  Reader r(io, **t);
+  ASSERT_TRUE(r.wait_for("Grbl", 3.0)) << "got: " << r.text() << " error: " << r.error().message();
+  ASSERT_FALSE(write_all(io, **t, "$I\n"));
+  EXPECT_TRUE(r.wait_for("[OPT:", 3.0)) << "got: " << r.text();
+}
+
+TEST(Transports, AMissingDeviceIsPortNotFoundNamingIt) {
+  boost::asio::io_context io;
+  for (auto result : {open_serial(io, "/nonexistent", {}), open_termios(io, "/nonexistent", {})}) {
+    ASSERT_FALSE(result);
+    EXPECT_EQ(result.error().code, LinkErrorCode::port_not_found);
+    EXPECT_NE(result.error().message.find("/nonexistent"), std::string::npos) << result.error().message;
+  }
+}
+
+TEST(Transports, AnUnknownUsbSerialNumberIsPortNotFoundListingThePorts) {
+  boost::asio::io_context io;
+  auto result = open_serial(io, "LAMINA0NOSUCHSERIAL", {});
+  ASSERT_FALSE(result);
+  EXPECT_EQ(result.error().code, LinkErrorCode::port_not_found);
+  const std::string& m = result.error().message;
+  EXPECT_NE(m.find("LAMINA0NOSUCHSERIAL"), std::string::npos) << m;
+  EXPECT_NE(m.find("ports: "), std::string::npos) << m;
+  const auto ports = list_serial_ports();
+  ASSERT_TRUE(ports);
+  for (const auto& p : *ports) EXPECT_NE(m.find(p.name), std::string::npos) << m;
+}
+
+TEST(Transports, SettingsTheLineCannotRunAreRefusedNamingTheSetting) {
+  PtySim s;
+  boost::asio::io_context io;
+  SerialSettings odd_baud;
+  odd_baud.baud = 100000;  // 13% from 115200: no UART would talk to it
+  auto refused = open_serial(io, s.link, odd_baud);
+  ASSERT_FALSE(refused);
+  EXPECT_EQ(refused.error().code, LinkErrorCode::configure_failed);
+  EXPECT_NE(refused.error().message.find("baud 100000"), std::string::npos) << refused.error().message;
+
+  SerialSettings close_baud;
+  close_baud.baud = 115000;  // within tolerance: runs at the standard rate and says so
+  auto rounded = open_serial(io, s.link, close_baud);
+  ASSERT_TRUE(rounded) << rounded.error().message;
+  EXPECT_NE((*rounded)->describe().find(" 115200 8N1"), std::string::npos) << (*rounded)->describe();
+
+  SerialSettings nine_bits;
+  nine_bits.data_bits = 9;
+  auto bad = open_serial(io, s.link, nine_bits);
+  ASSERT_FALSE(bad);
+  EXPECT_EQ(bad.error().code, LinkErrorCode::bad_request);
+  EXPECT_NE(bad.error().message.find("data bits"), std::string::npos) << bad.error().message;
+}
+
+TEST(Transports, TcpToAClosedPortIsOpenFailedNamingHostAndPort) {
+  const int port = closed_tcp_port();
+  boost::asio::io_context io;
+  auto result = open_tcp(io, "127.0.0.1", port, 1.0);
+  ASSERT_FALSE(result);
+  EXPECT_EQ(result.error().code, LinkErrorCode::open_failed);
+  EXPECT_NE(result.error().message.find("127.0.0.1:" + std::to_string(port)), std::string::npos)
+      << result.error().message;
+}
+
+TEST(Transports, TcpToASilentAddressGivesUpWithinItsTimeout) {
+  boost::asio::io_context io;
+  const auto t0 = std::chrono::steady_clock::now();
+  auto result = open_tcp(io, "10.255.255.1", 2323, 0.3);
+  const double elapsed_s = seconds_since(t0);
+  ASSERT_FALSE(result);
+  EXPECT_TRUE(result.error().code == LinkErrorCode::timeout || result.error().code == LinkErrorCode::open_failed)
+      << to_string(result.error().code) << ": " << result.error().message;
+  EXPECT_NE(result.error().message.find("10.255.255.1:2323"), std::string::npos) << result.error().message;
+  EXPECT_LT(elapsed_s, 1.0);
+}
+
+TEST(Transports, UnpluggingThePtyCompletesThePendingReadWithAnError) {
+  PtySim s;
+  boost::asio::io_context io;
+  auto t = open_serial(io, s.link, {});
+  ASSERT_TRUE(t) << t.error().message;
+  Reader r(io, **t);
+  ASSERT_TRUE(r.wait_for("Grbl", 3.0));
+  r.wait_for("\n", 0.5);  // the rest of the banner
+  r.start();
+  ASSERT_EQ(control(s.sim.control_port(), "unplug").find("error"), std::string::npos);
+  const auto t0 = std::chrono::steady_clock::now();
+  EXPECT_TRUE(r.wait_for_error(2.0)) << "the read hung after the unplug";
+  EXPECT_LT(seconds_since(t0), 2.0);
+  EXPECT_NE(r.error(), std::errc::operation_canceled) << r.error().message();
+}
+
+TEST(Transports, UnpluggingTheTcpLinkCompletesThePendingReadWithAnError) {
+  SimProcess sim({"--tcp", "127.0.0.1:0", "--unplug-at", "0.5"});
+  boost::asio::io_context io;
+  auto t = open_tcp(io, "127.0.0.1", sim.tcp_port(), 2.0);
+  ASSERT_TRUE(t) << t.error().message;
+  Reader r(io, **t);
+  EXPECT_TRUE(r.wait_for_error(3.0)) << "the read hung after the unplug; got: " << r.text();
+  EXPECT_NE(r.error(), std::errc::operation_canceled) << r.error().message();
+}
+
+TEST(Transports, CloseAbortsAPendingReadAndCanBeRepeated) {
+  PtySim s;
+  boost::asio::io_context io;
+  auto t = open_serial(io, s.link, {});
+  ASSERT_TRUE(t) << t.error().message;
+  Reader r(io, **t);
+  ASSERT_TRUE(r.wait_for("Grbl", 3.0));
+  r.wait_for("\n", 0.5);
+  r.start();
+  ASSERT_TRUE(r.pending());
+  (*t)->close();
+  (*t)->close();
+  EXPECT_TRUE(r.wait_for_error(1.0)) << "close() left the read pending";
+  EXPECT_EQ(r.error(), std::errc::operation_canceled) << r.error().message();
+}
+
+}  // namespace
