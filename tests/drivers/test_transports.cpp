@@ -5,6 +5,7 @@
 
 #include <array>
 #include <chrono>
+#include <iostream>
 #include <string>
 
 #include <boost/asio/io_context.hpp>
@@ -260,6 +261,8 @@ TEST(Transports, UnpluggingThePtyCompletesThePendingReadWithAnError) {
   EXPECT_TRUE(r.wait_for_error(2.0)) << "the read hung after the unplug";
   EXPECT_LT(seconds_since(t0), 2.0);
   EXPECT_NE(r.error(), std::errc::operation_canceled) << r.error().message();
+  EXPECT_EQ(to_link_error(r.error(), (*t)->describe()).code, LinkErrorCode::io_error);
+  std::cout << "  read ended with: " << r.error().message() << "\n";
 }
 
 TEST(Transports, UnpluggingTheTcpLinkCompletesThePendingReadWithAnError) {
@@ -270,6 +273,8 @@ TEST(Transports, UnpluggingTheTcpLinkCompletesThePendingReadWithAnError) {
   Reader r(io, **t);
   EXPECT_TRUE(r.wait_for_error(3.0)) << "the read hung after the unplug; got: " << r.text();
   EXPECT_NE(r.error(), std::errc::operation_canceled) << r.error().message();
+  EXPECT_EQ(to_link_error(r.error(), (*t)->describe()).code, LinkErrorCode::io_error);
+  std::cout << "  read ended with: " << r.error().message() << "\n";
 }
 
 TEST(Transports, CloseAbortsAPendingReadAndCanBeRepeated) {
@@ -286,6 +291,11 @@ TEST(Transports, CloseAbortsAPendingReadAndCanBeRepeated) {
   (*t)->close();
   EXPECT_TRUE(r.wait_for_error(1.0)) << "close() left the read pending";
   EXPECT_EQ(r.error(), std::errc::operation_canceled) << r.error().message();
+  EXPECT_EQ(to_link_error(r.error(), (*t)->describe()).code, LinkErrorCode::cancelled);
+  // An operation started after close() fails at once instead of hanging.
+  Reader after(io, **t);
+  EXPECT_TRUE(after.wait_for_error(1.0));
+  EXPECT_TRUE(after.text().empty());
 }
 
 }  // namespace
