@@ -44,6 +44,13 @@ struct PortInfo {
   std::string manufacturer, product;
 };
 
+// Threads: open_* run on the caller's thread and need no running io_context (TCP connects on a
+// private one and hands the socket over). After that, call async_read_some, async_write and
+// close() from the thread that runs the io_context (post to it from elsewhere): Asio I/O objects
+// are not thread-safe. Handlers run on that thread. At most one read and one write pending.
+// Handler errors: std::errc::operation_canceled after close(); anything else means the link is
+// gone or broken (EOF when the peer closes or a PTY is unplugged, EIO, ECONNRESET) — see
+// to_link_error(). Destroy the transport before its io_context.
 class Transport {
  public:
   using ReadHandler = std::function<void(std::error_code, std::size_t)>;
@@ -53,9 +60,13 @@ class Transport {
   virtual void async_read_some(std::span<std::uint8_t> buffer, ReadHandler handler) = 0;
   // Writes all of `data` (the buffer must stay alive until the handler runs).
   virtual void async_write(std::span<const std::uint8_t> data, WriteHandler handler) = 0;
-  virtual void close() = 0;  // pending operations complete with operation_aborted
+  virtual void close() = 0;  // pending operations complete with operation_aborted; idempotent
   virtual std::string describe() const = 0;  // "serial /dev/ttyUSB0 115200 8N1", "tcp 127.0.0.1:23"
 };
+
+// What a failed read or write means for the link: cancelled after close(), io_error otherwise
+// (the message names `where`, e.g. describe(), and the system's words).
+LinkError to_link_error(std::error_code ec, const std::string& where);
 
 // libserialport's view of the machine's ports.
 std::expected<std::vector<PortInfo>, LinkError> list_serial_ports();
