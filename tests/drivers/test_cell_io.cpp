@@ -148,6 +148,31 @@ TEST(CellIo, UnreachablePlcGivesUpAfterBoundedReconnects) {
   EXPECT_LT(took_s, 3.0);
 }
 
+TEST(CellIo, SilentPlcTimesOutAndGivesUpAfterBoundedReconnects) {
+  // A listener that never answers: connects succeed (the kernel's backlog), every request times out.
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  ::inet_pton(AF_INET, "127.0.0.1", &addr.sin_addr);
+  ASSERT_EQ(::bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr), 0);
+  ASSERT_EQ(::listen(fd, 16), 0);
+  socklen_t len = sizeof addr;
+  ::getsockname(fd, reinterpret_cast<sockaddr*>(&addr), &len);
+  auto settings = settings_for(ntohs(addr.sin_port));
+  settings.response_timeout_s = 0.2;
+  settings.max_reconnects = 2;
+  {
+    CellIo io(settings);
+    const auto t0 = std::chrono::steady_clock::now();
+    auto r = io.prepare_cut();
+    ASSERT_FALSE(r);
+    EXPECT_EQ(r.error().code, LinkErrorCode::modbus_error);
+    EXPECT_NE(r.error().message.find("timed out"), std::string::npos) << r.error().message;
+    EXPECT_LT(seconds_since(t0), 3.0);
+  }
+  ::close(fd);
+}
+
 TEST(CellIo, PlcLostWhileCuttingIsLinkLostWithoutHanging) {
   auto cell = std::make_unique<SimCell>();
   CellIo io(settings_for(cell->sim.modbus_port()));
