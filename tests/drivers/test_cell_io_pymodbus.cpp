@@ -5,6 +5,8 @@
 #include <spawn.h>
 #include <sys/wait.h>
 
+#include <fcntl.h>
+
 #include <cstdlib>
 #include <fstream>
 
@@ -44,12 +46,18 @@ StartTcpServer(context=ModbusServerContext(slaves=store, single=True), address=(
 
 class PythonServer {
  public:
-  PythonServer(const std::string& script, int port) {
+  // Its chatter (asyncio logs each closed connection as an error) goes to `log_path`.
+  PythonServer(const std::string& script, int port, const std::string& log_path) {
     std::vector<std::string> args{"/usr/bin/python3", script, std::to_string(port)};
     std::vector<char*> argv;
     for (auto& a : args) argv.push_back(a.data());
     argv.push_back(nullptr);
-    if (posix_spawn(&pid_, argv[0], nullptr, nullptr, argv.data(), environ) != 0) pid_ = -1;
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_addopen(&actions, 1, log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    posix_spawn_file_actions_adddup2(&actions, 1, 2);
+    if (posix_spawn(&pid_, argv[0], &actions, nullptr, argv.data(), environ) != 0) pid_ = -1;
+    posix_spawn_file_actions_destroy(&actions);
   }
   ~PythonServer() {
     if (pid_ <= 0) return;
@@ -70,7 +78,7 @@ TEST(CellIoPeer, PrepareCutAgainstPymodbusWritesTheCoils) {
   const std::string script = dir.file("plc.py");
   std::ofstream(script) << kServerScript;
   const int port = unused_port();
-  PythonServer server(script, port);
+  PythonServer server(script, port, dir.file("server.log"));
   ASSERT_TRUE(server.started());
   std::unique_ptr<PlcProbe> probe;
   ASSERT_TRUE(eventually([&] {
