@@ -11,7 +11,11 @@ inline constexpr int kCoilPumpEnable = 0;
 inline constexpr int kCoilAbrasiveEnable = 1;
 inline constexpr int kCoilJetOn = 2;
 inline constexpr int kCoilAlarmReset = 3;  // write 1: clear the latched alarm; reads back 0
-inline constexpr int kCoilCount = 4;
+// The CNC's panel buttons, wired through the PLC (write 1 = press; the PLC sets it back to 0).
+inline constexpr int kCoilCncFeedHold = 4;
+inline constexpr int kCoilCncCycleStart = 5;
+inline constexpr int kCoilCncReset = 6;
+inline constexpr int kCoilCount = 7;
 // Simulator-only fault coils (a real PLC has none): write 1 to inject, 0 to clear.
 inline constexpr int kCoilSimEstop = 100;         // e-stop pressed
 inline constexpr int kCoilSimDoorOpen = 101;      // door opened

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 namespace lamina::sim {
 namespace mm = modbus_map;
@@ -39,6 +40,7 @@ void Plc::after_client_write(double now_s) {
   take_client_bits();
   take_heartbeat(now_s);
   take_mailbox();
+  take_cnc_buttons_from_coils();
   // The reset comes after the heartbeat so a write carrying both a heartbeat and the reset works.
   if (regs_.coils[mm::kCoilAlarmReset]) {
     regs_.coils[mm::kCoilAlarmReset] = 0;  // self-clearing: reads back 0
@@ -67,6 +69,21 @@ void Plc::refuse_block(std::uint16_t seq) {
   pending_.reset();
   latch(mm::kAlarmMailboxBadBlock);
   publish(last_s_);
+}
+
+CncButtons Plc::take_cnc_buttons() { return std::exchange(buttons_, CncButtons{}); }
+
+void Plc::take_cnc_buttons_from_coils() {
+  // Push buttons: a press is remembered until the CNC side takes it, and the coil reads 0 again
+  // at once (like alarm_reset), so pressing twice needs no release write in between.
+  auto press = [&](int address, bool& pressed) {
+    if (!regs_.coils[address]) return;
+    regs_.coils[address] = 0;
+    pressed = true;
+  };
+  press(mm::kCoilCncFeedHold, buttons_.feed_hold);
+  press(mm::kCoilCncCycleStart, buttons_.cycle_start);
+  press(mm::kCoilCncReset, buttons_.reset);
 }
 
 void Plc::set_estop(bool pressed) {

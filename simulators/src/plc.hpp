@@ -44,6 +44,14 @@ struct CncSnapshot {
   std::size_t free_blocks = 0;
 };
 
+// CNC buttons pressed through coils 4…6 since the last take_cnc_buttons().
+struct CncButtons {
+  bool feed_hold = false;
+  bool cycle_start = false;
+  bool reset = false;
+  bool any() const { return feed_hold || cycle_start || reset; }
+};
+
 class Plc {
  public:
   explicit Plc(PlcConfig config);
@@ -58,6 +66,8 @@ class Plc {
   std::optional<MailboxBlock> pending_block() const;
   void accept_block(std::uint16_t seq);
   void refuse_block(std::uint16_t seq);  // the CNC refused the text: latch kAlarmMailboxBadBlock
+  // Buttons pressed since the last call (the CNC side acts on them once), then forgotten.
+  CncButtons take_cnc_buttons();
 
   // Faults (flags, control socket, sim coils all end here).
   void set_estop(bool pressed);
@@ -78,6 +88,7 @@ class Plc {
   void take_client_bits();          // sim fault coils, alarm_reset
   void take_heartbeat(double now_s);
   void take_mailbox();
+  void take_cnc_buttons_from_coils();
   void latch(std::uint16_t code);
   void try_reset(double now_s);
   bool heartbeat_alive(double now_s) const;
@@ -96,6 +107,7 @@ class Plc {
   double last_heartbeat_s_ = 0;
   std::uint16_t last_seq_ = 0;        // last mailbox_seq value acted on
   std::optional<MailboxBlock> pending_;
+  CncButtons buttons_;                // pressed, not yet taken by the CNC side
   std::uint32_t alarm_causes_ = 0;    // bit per alarm code still latched
   std::uint16_t alarm_code_ = modbus_map::kAlarmNone;
   CncSnapshot cnc_;

@@ -31,6 +31,7 @@ struct Constant {
 // so a constant added there without being added here, and documented, fails).
 const std::vector<Constant> kConstants{
     C(kCoilPumpEnable, coil), C(kCoilAbrasiveEnable, coil), C(kCoilJetOn, coil), C(kCoilAlarmReset, coil),
+    C(kCoilCncFeedHold, coil), C(kCoilCncCycleStart, coil), C(kCoilCncReset, coil),
     C(kCoilCount, size),
     C(kCoilSimEstop, sim_coil), C(kCoilSimDoorOpen, sim_coil), C(kCoilSimPressureDrop, sim_coil),
     C(kCoilSimStall, sim_coil), C(kCoilSimEnd, size),

@@ -157,7 +157,7 @@ TEST(ModbusServer, AddressesOutsideTheMapGetIllegalDataAddress) {
     EXPECT_EQ(rc, -1) << what;
     EXPECT_EQ(errno, EMBXILADD) << what << ": " << modbus_strerror(errno);
   };
-  expect_illegal_address(modbus_read_bits(c.get(), mm::kCoilCount, 1, bits), "coil 4");
+  expect_illegal_address(modbus_read_bits(c.get(), mm::kCoilCount, 1, bits), "coil 7");
   expect_illegal_address(modbus_read_bits(c.get(), 98, 4, bits), "coils 98..101 (starts in the gap)");
   expect_illegal_address(modbus_read_bits(c.get(), mm::kCoilSimEnd, 1, bits), "coil 104");
   expect_illegal_address(modbus_write_bit(c.get(), 50, 1), "write coil 50");

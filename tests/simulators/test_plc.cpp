@@ -395,5 +395,27 @@ TEST(Plc, SnapshotEncoding) {
   EXPECT_EQ(cell.in_reg(mm::kInMailboxFree), 65535);
 }
 
+TEST(Plc, CncButtonsArePushButtonsTakenOnce) {
+  Cell cell;
+  cell.coil(mm::kCoilCncFeedHold, true);
+  EXPECT_EQ(cell.r().coils[mm::kCoilCncFeedHold], 0) << "the PLC releases the button at once";
+  cell.run_to(0.1);  // a scan in between does not lose the press
+  auto pressed = cell.plc.take_cnc_buttons();
+  EXPECT_TRUE(pressed.feed_hold);
+  EXPECT_FALSE(pressed.cycle_start);
+  EXPECT_FALSE(pressed.reset);
+  EXPECT_FALSE(cell.plc.take_cnc_buttons().any()) << "a press acts once";
+
+  cell.r().coils[mm::kCoilCncCycleStart] = 1;
+  cell.r().coils[mm::kCoilCncReset] = 1;
+  cell.plc.after_client_write(cell.now);  // one FC15 write pressing two buttons
+  pressed = cell.plc.take_cnc_buttons();
+  EXPECT_TRUE(pressed.cycle_start);
+  EXPECT_TRUE(pressed.reset);
+  EXPECT_FALSE(pressed.feed_hold);
+  EXPECT_EQ(cell.r().coils[mm::kCoilCncCycleStart], 0);
+  EXPECT_EQ(cell.r().coils[mm::kCoilCncReset], 0);
+}
+
 }  // namespace
 }  // namespace lamina::sim

@@ -64,11 +64,14 @@ class CellIo {
   // condition and the value read.
   std::expected<void, LinkError> prepare_cut();
   // The independent off path: jet_on = 0 now, from any thread, ahead of anything queued.
+  // Worst case on a healthy link: one response timeout (the request in flight finishes first).
+  // During prepare_cut it also aborts the preparation (cancelled; the cell is switched off).
   void jet_off();
   // After the cut (or a stop): jet off, abrasive off, pump to idle (pump_enable = 0). Blocking.
   std::expected<void, LinkError> finish_cut();
   // While a cut is prepared, the first fault seen (sticky until the next prepare_cut); the
-  // callback (set before prepare_cut) runs on the Modbus thread when it happens.
+  // callback (set before prepare_cut) runs once on the Modbus thread when it happens; it must not
+  // call prepare_cut/finish_cut (they wait for that thread). jet_off() from it is fine.
   void on_fault(std::function<void(const CellFaultReport&)> callback);
   std::optional<CellFaultReport> fault() const;
   CellStatus status() const;

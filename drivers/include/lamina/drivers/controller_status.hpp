@@ -19,6 +19,7 @@ struct ControllerStatus {
   std::optional<int> rx_bytes_free;             // Bf: second field
   std::optional<std::int64_t> line_number;      // Ln:
   std::optional<double> feed_mm_per_s;          // FS: first field, converted from mm/min once
+  std::optional<std::uint64_t> executed_blocks; // blocks the controller finished (Modbus: executed_high/low)
 };
 
 // Parse a Grbl / grblHAL real-time report `<Idle|MPos:…|Bf:…|Ln:…|FS:…>` (with or without the

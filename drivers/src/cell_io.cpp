@@ -1,0 +1,304 @@
+// CellIo: one thread owns the libmodbus context (libmodbus blocks). Callers hand it commands
+// (prepare_cut, finish_cut) through a queue and wait on a future; jet_off() is an atomic flag the
+// thread checks before anything else. Worst-case jet_off latency on a healthy link: the request
+// in flight finishes first, so one response timeout (plus one write round trip). When the link is
+// failing, the off write goes through the bounded reconnects; meanwhile the heartbeat has stopped,
+// so the PLC's watchdog closes the jet after its own timeout anyway.
+#include "lamina/drivers/cell_io.hpp"
+
+#include <atomic>
+#include <condition_variable>
+#include <deque>
+#include <future>
+#include <mutex>
+#include <thread>
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include "cell_interlocks.hpp"
+#include "modbus_client.hpp"
+#include "plc_map.hpp"
+
+namespace lamina::drivers {
+namespace pm = plc_map;
+using Clock = std::chrono::steady_clock;
+using Result = std::expected<void, LinkError>;
+
+namespace {
+Clock::duration seconds(double s) { return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s)); }
+LinkError interlock(std::string message) { return {LinkErrorCode::interlock, std::move(message)}; }
+}  // namespace
+
+struct CellIo::Impl {
+  enum class Kind { prepare, finish };
+  struct Command {
+    Kind kind;
+    std::promise<Result> done;
+  };
+
+  explicit Impl(CellIoSettings s)
+      : settings(std::move(s)),
+        log(driver_logger("cell")),
+        client(ModbusTarget{settings.host, settings.port, settings.unit_id, settings.response_timeout_s,
+                            settings.max_reconnects},
+               log) {
+    client.set_abort([this] { return stopping.load(); });
+    thread = std::thread([this] { run(); });
+  }
+
+  CellIoSettings settings;
+  std::shared_ptr<spdlog::logger> log;
+  ModbusClient client;  // used on the thread only
+  std::thread thread;
+
+  mutable std::mutex mutex;  // guards the queue and everything shared below
+  std::condition_variable wake;
+  std::deque<Command> commands;
+  std::atomic<bool> jet_off_requested{false};
+  std::atomic<bool> stopping{false};
+  std::optional<CellFaultReport> fault;
+  std::function<void(const CellFaultReport&)> callback;
+  CellStatus status;
+
+  // Thread-only state.
+  bool monitoring = false;  // between a successful prepare_cut and finish_cut: heartbeat + polling
+  std::uint16_t heartbeat_value = 0;
+  Clock::time_point next_heartbeat, next_poll;
+
+  Result submit(Kind kind) {
+    std::future<Result> done;
+    {
+      std::lock_guard lock(mutex);
+      commands.push_back(Command{kind, {}});
+      done = commands.back().done.get_future();
+    }
+    wake.notify_all();
+    return done.get();
+  }
+
+  void run() {
+    while (true) {
+      if (jet_off_requested.exchange(false)) write_jet_off("jet_off() requested");
+      if (stopping) break;
+      std::optional<Command> command;
+      {
+        std::lock_guard lock(mutex);
+        if (!commands.empty()) {
+          command.emplace(std::move(commands.front()));
+          commands.pop_front();
+        }
+      }
+      if (command) {
+        command->done.set_value(command->kind == Kind::prepare ? prepare() : finish());
+        continue;
+      }
+      if (monitoring && Clock::now() >= next_heartbeat) beat();
+      if (monitoring && Clock::now() >= next_poll) poll();
+      const auto deadline = monitoring ? std::min(next_heartbeat, next_poll) : Clock::now() + std::chrono::seconds(1);
+      std::unique_lock lock(mutex);
+      wake.wait_until(lock, deadline, [this] { return !commands.empty() || jet_off_requested || stopping; });
+    }
+    // Best effort on the way out: the jet must not stay consented with nobody watching.
+    if (client.connected() || monitoring) {
+      if (auto r = client.write_bit(pm::kCoilJetOn, false); !r) log->warn("jet off at shutdown: {}", r.error().message);
+    }
+    std::lock_guard lock(mutex);
+    for (auto& c : commands) c.done.set_value(std::unexpected(LinkError{LinkErrorCode::cancelled, "CellIo destroyed"}));
+    commands.clear();
+  }
+
+  void write_jet_off(const char* why) {
+    if (auto r = client.write_bit(pm::kCoilJetOn, false); !r)
+      log->error("jet off ({}) failed: {}", why, r.error().message);
+    else
+      log->info("jet off: {}", why);
+  }
+
+  // Discrete inputs and the first input registers, decoded into `status`.
+  Result read_inputs() {
+    auto bits = client.read_input_bits(0, pm::kInputCount);
+    if (!bits) return std::unexpected(bits.error());
+    auto regs = client.read_input_registers(0, pm::kInAlarmCode + 1);
+    if (!regs) return std::unexpected(regs.error());
+    std::lock_guard lock(mutex);
+    decode_cell_inputs(*bits, *regs, status);
+    status.connected = client.connected();
+    status.reconnects = client.reconnects();
+    return {};
+  }
+  CellStatus snapshot() const {
+    std::lock_guard lock(mutex);
+    return status;
+  }
+
+  // Sleeps up to `s`, waking early for jet_off() or shutdown (prepare_cut aborts then).
+  bool interrupted_sleep(double s) {
+    std::unique_lock lock(mutex);
+    return wake.wait_for(lock, seconds(s), [this] { return jet_off_requested.load() || stopping.load(); });
+  }
+  std::optional<LinkError> aborted() {
+    if (stopping) return LinkError{LinkErrorCode::cancelled, "prepare_cut: CellIo shutting down"};
+    if (jet_off_requested) return LinkError{LinkErrorCode::cancelled, "prepare_cut: jet_off() requested meanwhile"};
+    return std::nullopt;
+  }
+
+  // A failed prepare leaves the cell off: jet, abrasive, pump (best effort; the link may be the fault).
+  Result fail(LinkError error) {
+    const std::uint8_t off[3] = {0, 0, 0};
+    if (auto r = client.write_bits(pm::kCoilPumpEnable, off); !r) log->warn("cell off after failure: {}", r.error().message);
+    log->error("prepare_cut failed: {}", error.message);
+    return std::unexpected(std::move(error));
+  }
+
+  Result reset_alarm() {
+    log->info("PLC alarm {} ({}) latched: pressing alarm_reset", snapshot().alarm_code, pm::alarm_name(snapshot().alarm_code));
+    if (auto r = client.write_bit(pm::kCoilAlarmReset, true); !r) return r;
+    return read_inputs();
+  }
+
+  Result prepare() {
+    {
+      std::lock_guard lock(mutex);
+      fault.reset();
+    }
+    monitoring = false;
+    if (auto r = read_inputs(); !r) return fail(r.error());
+    auto s = snapshot();
+    if (!s.estop_ok) return fail(interlock("cannot prepare the cut: e-stop pressed (estop_ok = 0)"));
+    if (!s.door_closed) return fail(interlock("cannot prepare the cut: door open (door_closed = 0)"));
+    // An alarm whose cause is gone (e.g. a released e-stop) would keep the pump off; clear it.
+    if (s.alarm_latched)
+      if (auto r = reset_alarm(); !r) return fail(r.error());
+    if (auto r = client.write_register(pm::kHoldPressureSetpoint, settings.pressure_setpoint_01mpa); !r)
+      return fail(r.error());
+    if (auto r = client.write_bit(pm::kCoilPumpEnable, true); !r) return fail(r.error());
+
+    const auto pump_deadline = Clock::now() + seconds(settings.pump_ready_timeout_s);
+    while (true) {
+      if (auto r = read_inputs(); !r) return fail(r.error());
+      s = snapshot();
+      if (!s.estop_ok) return fail(interlock("e-stop pressed while the pump started (estop_ok = 0)"));
+      if (!s.door_closed) return fail(interlock("door opened while the pump started (door_closed = 0)"));
+      if (s.pump_ready) break;
+      if (Clock::now() >= pump_deadline)
+        return fail(interlock(fmt::format("pump not ready after {} s, pressure {:.1f} MPa of {:.1f} MPa",
+                                          settings.pump_ready_timeout_s, s.pressure_mpa,
+                                          mpa_from_01mpa(settings.pressure_setpoint_01mpa))));
+      if (interrupted_sleep(std::max(0.01, settings.poll_period_s))) return fail(*aborted());
+    }
+
+    if (auto r = client.write_register(pm::kHoldAbrasiveSetpoint, settings.abrasive_g_per_min); !r)
+      return fail(r.error());
+    if (auto r = client.write_bit(pm::kCoilAbrasiveEnable, true); !r) return fail(r.error());
+    // Heartbeat from the PLC's current value, so the first write is a change it counts.
+    auto hb = client.read_registers(pm::kHoldHeartbeat, 1);
+    if (!hb) return fail(hb.error());
+    heartbeat_value = (*hb)[0];
+    if (auto r = beat_once(); !r) return fail(r.error());
+    // A heartbeat alarm from an earlier session clears now that heartbeats come again.
+    if (auto r = read_inputs(); !r) return fail(r.error());
+    if (snapshot().alarm_latched) {
+      if (auto r = reset_alarm(); !r) return fail(r.error());
+      s = snapshot();
+      if (s.alarm_latched)
+        return fail(interlock(fmt::format("PLC alarm {} ({}) still latched after alarm_reset", s.alarm_code,
+                                          pm::alarm_name(s.alarm_code))));
+    }
+    if (auto e = aborted()) return fail(*e);
+    if (auto r = client.write_bit(pm::kCoilJetOn, true); !r) return fail(r.error());
+    // jet_is_on is not required: a real PLC may report the valve itself, closed until the CNC's M-code.
+    if (auto r = read_inputs(); r && !snapshot().jet_is_on) log->info("jet consent given; the valve reads closed");
+    monitoring = true;
+    next_poll = Clock::now();
+    log->info("cut prepared: pressure {:.1f} MPa, abrasive {} g/min", snapshot().pressure_mpa, settings.abrasive_g_per_min);
+    return {};
+  }
+
+  Result finish() {
+    monitoring = false;  // the heartbeat stops with it: the PLC's watchdog takes over
+    Result first = {};
+    for (int coil : {pm::kCoilJetOn, pm::kCoilAbrasiveEnable, pm::kCoilPumpEnable})
+      if (auto r = client.write_bit(coil, false); !r && first) first = std::unexpected(r.error());
+    if (first) log->info("cut finished: jet, abrasive and pump off");
+    return first;
+  }
+
+  Result beat_once() {
+    heartbeat_value = static_cast<std::uint16_t>(heartbeat_value + 1);  // always a change
+    next_heartbeat = Clock::now() + seconds(settings.heartbeat_period_s);
+    return client.write_register(pm::kHoldHeartbeat, heartbeat_value);
+  }
+  void beat() {
+    if (auto r = beat_once(); !r) link_lost(r.error());
+  }
+
+  void poll() {
+    next_poll = Clock::now() + seconds(settings.poll_period_s);
+    if (auto r = read_inputs(); !r) return link_lost(r.error());
+    if (has_fault()) return;
+    if (auto f = check_interlocks(snapshot(), settings)) {
+      write_jet_off(f->message.c_str());  // first: the independent off path
+      report(std::move(*f));
+    }
+  }
+
+  void link_lost(const LinkError& error) {
+    monitoring = false;
+    {
+      std::lock_guard lock(mutex);
+      status.connected = false;
+      status.reconnects = client.reconnects();
+    }
+    report(CellFaultReport{CellFault::link_lost, error.message});
+  }
+
+  bool has_fault() const {
+    std::lock_guard lock(mutex);
+    return fault.has_value();
+  }
+  void report(CellFaultReport f) {
+    std::function<void(const CellFaultReport&)> cb;
+    {
+      std::lock_guard lock(mutex);
+      if (fault) return;  // sticky: the first fault is the one that stopped the cut
+      fault = f;
+      cb = callback;
+    }
+    log->error("cell fault: {}", f.message);
+    if (cb) cb(f);
+  }
+};
+
+CellIo::CellIo(CellIoSettings settings) : impl_(std::make_unique<Impl>(std::move(settings))) {}
+
+CellIo::~CellIo() {
+  impl_->stopping = true;
+  impl_->wake.notify_all();
+  impl_->thread.join();
+}
+
+std::expected<void, LinkError> CellIo::prepare_cut() { return impl_->submit(Impl::Kind::prepare); }
+std::expected<void, LinkError> CellIo::finish_cut() { return impl_->submit(Impl::Kind::finish); }
+
+void CellIo::jet_off() {
+  impl_->jet_off_requested = true;
+  impl_->wake.notify_all();
+}
+
+void CellIo::on_fault(std::function<void(const CellFaultReport&)> callback) {
+  std::lock_guard lock(impl_->mutex);
+  impl_->callback = std::move(callback);
+}
+
+std::optional<CellFaultReport> CellIo::fault() const {
+  std::lock_guard lock(impl_->mutex);
+  return impl_->fault;
+}
+
+CellStatus CellIo::status() const {
+  std::lock_guard lock(impl_->mutex);
+  return impl_->status;
+}
+
+}  // namespace lamina::drivers

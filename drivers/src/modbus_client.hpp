@@ -1,0 +1,74 @@
+#pragma once
+// One libmodbus TCP connection with bounded, logged reconnects — shared by CellIo and
+// ModbusBlockLink. Not thread-safe: each owner uses it from its own thread only.
+//
+// Transport failures (ETIMEDOUT, EIO, ECONNRESET, EPIPE, ECONNREFUSED, EMBBADDATA, …) close the
+// socket and the request is retried on a new connection, up to max_reconnects times with a short
+// backoff. Every request here is safe to repeat: coil and register writes are idempotent, and the
+// PLC ignores a rewritten mailbox sequence number. A Modbus exception response (the PLC refused
+// the request) is returned at once: reconnecting would not change the answer.
+#include <cstdint>
+#include <expected>
+#include <functional>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "lamina/drivers/link_error.hpp"
+
+struct _modbus;  // libmodbus's modbus_t; its header stays in the .cpp
+
+namespace spdlog {
+class logger;
+}
+
+namespace lamina::drivers {
+
+struct ModbusTarget {
+  std::string host;
+  int port = 502;
+  int unit_id = 1;
+  double response_timeout_s = 0.5;
+  int max_reconnects = 3;
+  double backoff_s = 0.05;  // before reconnect k: k × this
+};
+
+// Named logger shared by every instance ("cell", "modbus-link"), created on first use.
+std::shared_ptr<spdlog::logger> driver_logger(const std::string& name);
+
+class ModbusClient {
+ public:
+  ModbusClient(ModbusTarget target, std::shared_ptr<spdlog::logger> log);
+  ~ModbusClient();
+  ModbusClient(const ModbusClient&) = delete;
+  ModbusClient& operator=(const ModbusClient&) = delete;
+
+  std::expected<std::vector<std::uint8_t>, LinkError> read_input_bits(int address, int count);
+  std::expected<std::vector<std::uint16_t>, LinkError> read_input_registers(int address, int count);
+  std::expected<std::vector<std::uint16_t>, LinkError> read_registers(int address, int count);
+  std::expected<void, LinkError> write_bit(int address, bool on);
+  std::expected<void, LinkError> write_bits(int address, std::span<const std::uint8_t> bits);
+  std::expected<void, LinkError> write_register(int address, std::uint16_t value);
+  std::expected<void, LinkError> write_registers(int address, std::span<const std::uint16_t> values);
+
+  bool connected() const { return ctx_ != nullptr; }
+  int reconnects() const { return reconnects_; }  // since construction
+  std::string where() const;                      // "127.0.0.1:502"
+  void close();
+  // Checked before every reconnect: true gives up at once (the owner is shutting down).
+  void set_abort(std::function<bool()> abort) { abort_ = std::move(abort); }
+
+ private:
+  // Runs op on a connected context; the retry policy above. `what` names the request in errors.
+  std::expected<void, LinkError> call(const std::string& what, const std::function<int(_modbus*)>& op);
+  bool connect_once(std::string& error);
+
+  ModbusTarget target_;
+  std::shared_ptr<spdlog::logger> log_;
+  _modbus* ctx_ = nullptr;
+  int reconnects_ = 0;
+  std::function<bool()> abort_;
+};
+
+}  // namespace lamina::drivers

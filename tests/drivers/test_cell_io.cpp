@@ -1,0 +1,217 @@
+// CellIo against the lamina-sim PLC (a separate process): bringing the cell up, the heartbeat,
+// interlock faults while cutting, refusals before cutting, an unreachable PLC, and shutting down.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <mutex>
+
+#include "lamina/drivers/cell_io.hpp"
+#include "modbus_test_client.hpp"
+
+namespace lamina::drivers {
+namespace {
+using namespace testing;
+
+CellIoSettings settings_for(int port) {
+  CellIoSettings s;
+  s.port = port;
+  s.poll_period_s = 0.05;
+  s.heartbeat_period_s = 0.1;  // the sim's watchdog is 500 ms
+  s.pump_ready_timeout_s = 3;
+  return s;
+}
+
+// Records faults as the callback sees them (on the Modbus thread).
+struct FaultLog {
+  std::mutex mutex;
+  std::vector<CellFaultReport> seen;
+  std::chrono::steady_clock::time_point first_at;
+  void attach(CellIo& cell) {
+    cell.on_fault([this](const CellFaultReport& f) {
+      std::lock_guard lock(mutex);
+      if (seen.empty()) first_at = std::chrono::steady_clock::now();
+      seen.push_back(f);
+    });
+  }
+  std::size_t count() {
+    std::lock_guard lock(mutex);
+    return seen.size();
+  }
+};
+
+TEST(CellIo, PrepareCutBringsTheCellUp) {
+  SimCell cell;
+  CellIo io(settings_for(cell.sim.modbus_port()));
+  auto r = io.prepare_cut();
+  ASSERT_TRUE(r) << r.error().message;
+  PlcProbe plc(cell.sim.modbus_port());
+  EXPECT_EQ(plc.coil(map::kCoilPump), 1);
+  EXPECT_EQ(plc.coil(map::kCoilAbrasive), 1);
+  EXPECT_EQ(plc.coil(map::kCoilJet), 1);
+  EXPECT_EQ(plc.input(map::kInputPumpReady), 1);
+  EXPECT_EQ(plc.input(map::kInputJetIsOn), 1);
+  const CellStatus st = io.status();
+  EXPECT_TRUE(st.connected);
+  EXPECT_NEAR(st.pressure_mpa, 380.0, 20.0);
+  EXPECT_FALSE(io.fault());
+}
+
+TEST(CellIo, HeartbeatKeepsTheWatchdogQuietAndItsSilenceTripsIt) {
+  SimCell cell;
+  PlcProbe plc(cell.sim.modbus_port());
+  auto io = std::make_unique<CellIo>(settings_for(cell.sim.modbus_port()));
+  ASSERT_TRUE(io->prepare_cut());
+  std::this_thread::sleep_for(std::chrono::seconds(2));  // four watchdog timeouts
+  EXPECT_EQ(plc.input(map::kInputAlarmLatched), 0);
+  EXPECT_EQ(plc.input(map::kInputJetIsOn), 1);
+  EXPECT_FALSE(io->fault());
+  io.reset();  // no finish_cut: the heartbeat just stops (the destructor closes the jet)
+  EXPECT_EQ(plc.coil(map::kCoilJet), 0);
+  EXPECT_TRUE(eventually([&] { return plc.in_reg(map::kInAlarmCode) == 2; }, 2.0)) << "heartbeat alarm latched";
+}
+
+// One interlock fault while cutting: reported once, within two poll periods, jet consent removed.
+void expect_fault_while_cutting(const std::string& command, CellFault expected, const std::string& word) {
+  SimCell cell;
+  PlcProbe plc(cell.sim.modbus_port());
+  const auto settings = settings_for(cell.sim.modbus_port());
+  CellIo io(settings);
+  FaultLog faults;
+  faults.attach(io);
+  ASSERT_TRUE(io.prepare_cut());
+  const auto t0 = std::chrono::steady_clock::now();
+  ASSERT_EQ(control(cell.sim.control_port(), command), "ok");
+  ASSERT_TRUE(eventually([&] { return faults.count() > 0; }, 2.0)) << "no fault after " << command;
+  const double latency_s = std::chrono::duration<double>(faults.first_at - t0).count();
+  // Two poll periods, plus the control socket's own round trip and scheduling slack on a busy box.
+  EXPECT_LT(latency_s, 2 * settings.poll_period_s + 0.05) << command;
+  ::testing::Test::RecordProperty("fault_latency_ms", static_cast<int>(latency_s * 1000));
+  EXPECT_EQ(plc.coil(map::kCoilJet), 0) << "jet consent must be withdrawn";
+  EXPECT_EQ(plc.input(map::kInputJetIsOn), 0);
+  ASSERT_TRUE(io.fault());
+  EXPECT_EQ(io.fault()->fault, expected);
+  EXPECT_NE(io.fault()->message.find(word), std::string::npos) << io.fault()->message;
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  EXPECT_EQ(faults.count(), 1u) << "the callback runs once";
+}
+
+TEST(CellIo, EstopWhileCuttingIsAFaultAndTheJetGoesOff) {
+  expect_fault_while_cutting("estop on", CellFault::estop, "e-stop");
+}
+
+TEST(CellIo, DoorOpenedWhileCuttingIsAFault) { expect_fault_while_cutting("door open", CellFault::door_open, "door"); }
+
+TEST(CellIo, ScheduledEstopIsSeenToo) {
+  SimCell cell({"--estop-at", "1.5"});
+  PlcProbe plc(cell.sim.modbus_port());
+  CellIo io(settings_for(cell.sim.modbus_port()));
+  ASSERT_TRUE(io.prepare_cut());
+  ASSERT_TRUE(eventually([&] { return io.fault().has_value(); }, 5.0));
+  EXPECT_EQ(io.fault()->fault, CellFault::estop);
+  EXPECT_EQ(plc.coil(map::kCoilJet), 0);
+}
+
+TEST(CellIo, PressureDropIsAFault) {
+  SimCell cell({"--pressure-drop-at", "1.5"});
+  PlcProbe plc(cell.sim.modbus_port());
+  CellIo io(settings_for(cell.sim.modbus_port()));
+  ASSERT_TRUE(io.prepare_cut());
+  ASSERT_TRUE(eventually([&] { return io.fault().has_value(); }, 5.0));
+  EXPECT_EQ(io.fault()->fault, CellFault::pressure_low) << io.fault()->message;
+  EXPECT_NE(io.fault()->message.find("MPa"), std::string::npos) << io.fault()->message;
+  EXPECT_EQ(plc.coil(map::kCoilJet), 0);
+}
+
+TEST(CellIo, PrepareWithTheDoorOpenIsRefusedNamingTheDoor) {
+  SimCell cell;
+  ASSERT_EQ(control(cell.sim.control_port(), "door open"), "ok");
+  CellIo io(settings_for(cell.sim.modbus_port()));
+  auto r = io.prepare_cut();
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error().code, LinkErrorCode::interlock);
+  EXPECT_NE(r.error().message.find("door"), std::string::npos) << r.error().message;
+  PlcProbe plc(cell.sim.modbus_port());
+  EXPECT_EQ(plc.coil(map::kCoilPump), 0);
+  EXPECT_EQ(plc.coil(map::kCoilJet), 0);
+}
+
+TEST(CellIo, UnreachablePlcGivesUpAfterBoundedReconnects) {
+  auto settings = settings_for(unused_port());
+  settings.max_reconnects = 3;
+  CellIo io(settings);
+  const auto t0 = std::chrono::steady_clock::now();
+  auto r = io.prepare_cut();
+  const double took_s = seconds_since(t0);
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error().code, LinkErrorCode::modbus_error);
+  EXPECT_NE(r.error().message.find("after 3 reconnects"), std::string::npos) << r.error().message;
+  EXPECT_LT(took_s, 3.0);
+}
+
+TEST(CellIo, SilentPlcTimesOutAndGivesUpAfterBoundedReconnects) {
+  // A listener that never answers: connects succeed (the kernel's backlog), every request times out.
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  ::inet_pton(AF_INET, "127.0.0.1", &addr.sin_addr);
+  ASSERT_EQ(::bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr), 0);
+  ASSERT_EQ(::listen(fd, 16), 0);
+  socklen_t len = sizeof addr;
+  ::getsockname(fd, reinterpret_cast<sockaddr*>(&addr), &len);
+  auto settings = settings_for(ntohs(addr.sin_port));
+  settings.response_timeout_s = 0.2;
+  settings.max_reconnects = 2;
+  {
+    CellIo io(settings);
+    const auto t0 = std::chrono::steady_clock::now();
+    auto r = io.prepare_cut();
+    ASSERT_FALSE(r);
+    EXPECT_EQ(r.error().code, LinkErrorCode::modbus_error);
+    EXPECT_NE(r.error().message.find("timed out"), std::string::npos) << r.error().message;
+    EXPECT_LT(seconds_since(t0), 3.0);
+  }
+  ::close(fd);
+}
+
+TEST(CellIo, PlcLostWhileCuttingIsLinkLostWithoutHanging) {
+  auto cell = std::make_unique<SimCell>();
+  CellIo io(settings_for(cell->sim.modbus_port()));
+  FaultLog faults;
+  faults.attach(io);
+  ASSERT_TRUE(io.prepare_cut());
+  cell->sim.stop();
+  ASSERT_TRUE(eventually([&] { return faults.count() > 0; }, 5.0));
+  EXPECT_EQ(io.fault()->fault, CellFault::link_lost) << io.fault()->message;
+  EXPECT_GE(io.status().reconnects, 3);
+  const auto t0 = std::chrono::steady_clock::now();
+  EXPECT_FALSE(io.finish_cut());  // still unreachable: an error, not a hang
+  EXPECT_LT(seconds_since(t0), 3.0);
+}
+
+TEST(CellIo, FinishCutLeavesPumpAbrasiveAndJetOff) {
+  SimCell cell;
+  PlcProbe plc(cell.sim.modbus_port());
+  CellIo io(settings_for(cell.sim.modbus_port()));
+  ASSERT_TRUE(io.prepare_cut());
+  auto r = io.finish_cut();
+  ASSERT_TRUE(r) << r.error().message;
+  EXPECT_EQ(plc.coil(map::kCoilJet), 0);
+  EXPECT_EQ(plc.coil(map::kCoilAbrasive), 0);
+  EXPECT_EQ(plc.coil(map::kCoilPump), 0);
+  EXPECT_EQ(plc.input(map::kInputJetIsOn), 0);
+}
+
+TEST(CellIo, JetOffFromAnotherThreadClosesTheJet) {
+  SimCell cell;
+  PlcProbe plc(cell.sim.modbus_port());
+  CellIo io(settings_for(cell.sim.modbus_port()));
+  ASSERT_TRUE(io.prepare_cut());
+  const auto t0 = std::chrono::steady_clock::now();
+  std::thread([&] { io.jet_off(); }).join();
+  ASSERT_TRUE(eventually([&] { return plc.coil(map::kCoilJet) == 0; }, 1.0));
+  EXPECT_LT(seconds_since(t0), 0.5 + 0.1) << "at most one response timeout";
+  EXPECT_EQ(plc.coil(map::kCoilPump), 1) << "jet_off touches the jet only";
+}
+
+}  // namespace
+}  // namespace lamina::drivers
