@@ -94,6 +94,7 @@ struct ModbusBlockLink::Impl {
       {
         std::lock_guard lock(mutex);
         progress.last_status = status;
+        ++progress.statuses_received;
         if (running) progress.seconds = std::chrono::duration<double>(Clock::now() - job_start).count();
         on_status = callbacks.on_status;
         on_progress = running ? callbacks.on_progress : nullptr;
@@ -290,6 +291,20 @@ LinkProgress ModbusBlockLink::progress() const {
   LinkProgress p = impl_->progress;
   if (impl_->running) p.seconds = std::chrono::duration<double>(Clock::now() - impl_->job_start).count();
   return p;
+}
+
+std::optional<LinkError> ModbusBlockLink::recover(double timeout_s) {
+  // The PLC's reset button clears the CNC's queue and alarm; wait for a report that says so.
+  const std::size_t before = progress().statuses_received;
+  request(RealtimeCommand::reset);
+  const auto deadline = Clock::now() + seconds(timeout_s);
+  while (Clock::now() < deadline) {
+    const LinkProgress p = progress();
+    if (p.statuses_received > before + 1 && p.last_status && p.last_status->state != ControllerState::alarm)
+      return std::nullopt;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  return LinkError{LinkErrorCode::timeout, "the CNC is still in alarm after the PLC's reset"};
 }
 
 std::optional<LinkOutcome> ModbusBlockLink::wait(double timeout_s) {
