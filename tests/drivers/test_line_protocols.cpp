@@ -348,6 +348,13 @@ TEST(XonXoffProtocol, LineIsAcceptedWhenItsLfIsWritten) {
   EXPECT_FALSE(p->finished()) << "the closing % is still to go";
   EXPECT_EQ(p->take_sendable(), "\n");
   EXPECT_TRUE(p->finished());
+  // A chunk that stops just before the LF: the line is not written yet.
+  auto q = make_xonxoff_protocol({.chunk_bytes = 6});
+  q->load(LineSpan{{"G1X1"}, 0});
+  EXPECT_EQ(q->take_sendable(), "%\nG1X1");
+  EXPECT_EQ(q->lines_accepted(), 0u);
+  EXPECT_EQ(q->take_sendable(), "\n%\n");
+  EXPECT_EQ(q->lines_accepted(), 1u);
 }
 
 TEST(XonXoffProtocol, SynAfterDc3IsAResetAndStops) {
