@@ -75,6 +75,18 @@ TEST(GrblProtocol, HandshakeLearnsBuildInfoAtItsOk) {
   EXPECT_EQ(count_lines(p->take_sendable()), 3u);
 }
 
+TEST(GrblProtocol, ResetDuringTheHandshakeNeedsItAgain) {
+  // Opening a port resets many Grbl boards (DTR): the `$I` sent at once is lost in the boot.
+  auto p = make_grbl_protocol();
+  EXPECT_EQ(p->handshake(), "$I\n");
+  EXPECT_EQ(only<ControllerReset>(feed_bytewise(*p, "\r\nGrblHAL 1.1f ['$' or '$HELP' for help]\r\n")).size(), 1u);
+  EXPECT_FALSE(p->handshake_done());
+  EXPECT_EQ(only<ProtocolViolation>(feed_bytewise(*p, "ok\r\n")).size(), 1u) << "the lost $I has no ok to come";
+  EXPECT_EQ(p->handshake(), "$I\n");
+  EXPECT_EQ(only<ControllerInfo>(feed_bytewise(*p, "[OPT:VNL,35,1024,5,0]\r\nok\r\n")).size(), 1u);
+  EXPECT_TRUE(p->handshake_done());
+}
+
 TEST(GrblProtocol, WindowComesFromOptUnlessConfigured) {
   // Learned 256: five 50-byte lines fit (250), a sixth would not.
   auto learned = connected_grbl(256);
