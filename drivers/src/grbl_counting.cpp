@@ -63,6 +63,8 @@ class CountingProtocol final : public LineProtocol {
     if (halted_ || !handshake_done_) return out;
     const std::size_t window = window_bytes();
     while (next_ < span_.lines.size()) {
+      // Sent as loaded but for a trailing CR (we end lines with LF alone). The caller loads no
+      // empty lines; one would still work (grblHAL answers it `ok`) but clear an error lock.
       std::string_view line = span_.lines[next_];
       if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
       const std::size_t bytes = line.size() + 1;
