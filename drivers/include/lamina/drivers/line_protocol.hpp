@@ -102,8 +102,18 @@ struct XonXoffProtocolSettings {
   bool send_percent_frame = true;  // `%` before and after the program when the program lacks it
 };
 
+// Grbl character counting. handshake() sends `$I`; its `ok` ends the handshake with a
+// ControllerInfo whose rx_buffer_bytes is the window in use (configured, else `[OPT:]`, else
+// 128). A banner (ControllerReset) during the handshake loses the `$I`: call handshake() again.
+// After LineRejected the caller sends clear_error_lock() (the protocol expects its `ok`); the
+// lines already in flight are answered by the error lock (or, after ALARM, refused or
+// flushed) and reported as nothing. A banner halts and forgets the lines in flight.
 std::unique_ptr<LineProtocol> make_grbl_protocol(GrblProtocolSettings settings = {});
+// The same grammar with one line in flight and no handshake.
 std::unique_ptr<LineProtocol> make_send_response_protocol();  // one line in flight, ok/error
+// XON/XOFF: lines_accepted() counts a line once its LF is handed out; its LineAccepted event
+// comes with the next on_received() (take_sendable cannot report events). finished() waits
+// for the closing `%` too. No real-time bytes: hold, resume and reset go through the PLC.
 std::unique_ptr<LineProtocol> make_xonxoff_protocol(XonXoffProtocolSettings settings = {});
 
 }  // namespace lamina::drivers
