@@ -190,6 +190,9 @@ struct Streamer::Impl {
         finish(LinkError{LinkErrorCode::controller_alarm, fmt::format("alarm {}: {}", a->code, a->meaning)});
       } else if (const auto* reset = std::get_if<ControllerReset>(&event)) {
         resets_seen.fetch_add(1);
+        // A board that resets when its port opens (DTR on an Arduino Grbl) eats the first
+        // handshake: ask again once it has printed its banner.
+        if (handshaking) send_realtime_bytes(protocol->handshake());
         if (streaming && loaded)
           finish(LinkError{LinkErrorCode::controller_alarm, fmt::format("the controller reset itself ({})", reset->text)});
       } else if (const auto* info = std::get_if<ControllerInfo>(&event)) {
@@ -267,6 +270,11 @@ struct Streamer::Impl {
                              {
                                std::lock_guard lock(mutex);
                                shared_progress.bytes_sent += n;
+                             }
+                             // A drip feed is done when its last byte is out: no ack will come.
+                             if (streaming && loaded && protocol->finished()) {
+                               publish_progress();
+                               finish(std::nullopt);
                              }
                              pump();
                            });

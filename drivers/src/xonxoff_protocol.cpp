@@ -97,6 +97,7 @@ class XonXoffProtocol final : public LineProtocol {
   std::string realtime(RealtimeCommand) const override { return {}; }
   std::string clear_error_lock() const override { return {}; }
 
+  bool flow_stopped() const override { return xoff_ && !halted_; }
   std::size_t lines_sent() const override { return written_lines_; }
   std::size_t lines_accepted() const override { return written_lines_; }
   // Done when the closing `%` is out too: the controller ends the tape image there.
