@@ -27,11 +27,8 @@ constexpr std::uint8_t kStatusReportAll = 0x87;
 
 class GrblProtocol final : public CncProtocol {
  public:
-  // The planner size for $I is read while the machine is fresh (Machine does not expose its
-  // configuration): free + queued is the capacity whenever no block is running.
   GrblProtocol(Machine& machine, GrblParams params)
-      : machine_(machine), params_(params),
-        planner_blocks_(machine.free_blocks() + machine.queued_blocks()) {}
+      : machine_(machine), params_(params), planner_blocks_(machine.planner_blocks()) {}
 
   void on_connect(double /*now_s*/) override {
     out_ += grbl::banner();
@@ -84,9 +81,11 @@ class GrblProtocol final : public CncProtocol {
   const ProtocolCounters& counters() const override { return counters_; }
 
  private:
-  // Takes and answers one complete line. False when there is none, or the machine has no
-  // room for it (the line waits in the receive buffer: that back-pressure is what a
-  // character-counting sender sees in the missing `ok`).
+  // Takes and answers one complete line. False when there is none, or it is a motion line and
+  // the planner is full (the line waits in the receive buffer: that back-pressure is what a
+  // character-counting sender sees in the missing `ok`). Comments and modal-only lines take no
+  // planner block, so they pass as soon as every line before them has: a host may then count
+  // executed lines as acknowledged lines minus the motion blocks that Bf says are queued.
   bool take_line(double now_s) {
     const auto eol_it = std::find_if(rx_.begin(), rx_.end(), [](char c) { return c == '\n' || c == '\r'; });
     if (eol_it == rx_.end()) return false;
@@ -116,7 +115,7 @@ class GrblProtocol final : public CncProtocol {
 
     const bool is_gcode = !overflow && !line.empty() && line.front() != '$';
     const bool locked = is_gcode && (machine_.state() == MachineState::alarm || last_error_ != 0);
-    if (is_gcode && !locked && !machine_.has_room()) return false;
+    if (is_gcode && !locked && !machine_.has_room_for(line)) return false;
 
     rx_.erase(rx_.begin(), std::next(eol_it));
     last_eol_ = eol;

@@ -1,8 +1,10 @@
 // The simulated CNC's executor: queue, modal state, feed hold, alarms, events.
 //
 // Behaviour where the header leaves room (all Grbl-like unless said):
-// - The running block keeps its planner slot until it finishes (Grbl frees a block when it is
-//   done), so queued_blocks() and the capacity count it.
+// - Only timed blocks (a move that goes somewhere, a dwell with P > 0) occupy the planner, as
+//   only motion does in grblHAL; zero-time lines still queue in program order (no capacity) so
+//   each one is logged when the machine reaches it. The running block keeps its planner slot
+//   until it finishes (Grbl frees a block when it is done), so free_blocks() counts it.
 // - A block starts when the previous one ended, or at its submit time if the queue had run dry,
 //   or at the cycle-start time after a hold.
 // - Feed hold in Idle enters Hold at once (Grbl 1.1 too); lines sent then wait for `~`. A hold
@@ -15,7 +17,8 @@
 //   dwell or a completed hold.
 // - Soft-limit alarms report the seq the refused line would have had (accepted_blocks() + 1),
 //   which is its program line when a sender streams a program line for line.
-// - submit_line without room is refused with overflow (a caller bug; nothing is queued).
+// - A timed line submitted without room is refused with overflow and nothing changes: the
+//   protocols ask has_room_for first and keep the line in their receive buffer meanwhile.
 #include "machine.hpp"
 
 #include <algorithm>
@@ -27,31 +30,49 @@ namespace lamina::sim {
 
 Machine::Machine(MachineConfig config) : config_(std::move(config)) {}
 
+namespace {
+// Occupies a planner slot: grblHAL plans a block only for a move that goes somewhere (an empty
+// move is dropped by plan_buffer_line). Simplification: a dwell takes a slot too, although
+// grblHAL's G4 waits for the planner to drain instead; either way the host sees the dwell
+// line acknowledged only once everything before it has a block.
+bool is_timed(const detail::PlannedBlock& b) { return b.duration_s > 0; }
+}  // namespace
+
+Machine::Planned Machine::plan_line(std::string_view line) const {
+  Planned out;
+  out.modal = modal_;
+  const ParseResult parsed = parse_block(line, config_.parse);
+  out.status = parsed.status;
+  if (parsed.status != GrblStatus::ok || parsed.block.percent) return out;
+  detail::PlannedBlock planned;
+  out.status = detail::plan_block(parsed.block, out.modal, planned_pos_, config_, planned);
+  if (out.status != GrblStatus::ok) return out;
+  if (planned.program_end) {
+    // Grbl's program end resets these in the parser state as the line is read.
+    out.modal.motion = MotionMode::linear;
+    out.modal.relative = false;
+    if (out.modal.inverse_time) out.modal.feed_mm_per_min.reset();
+    out.modal.inverse_time = false;
+  }
+  out.block = std::move(planned);
+  return out;
+}
+
 GrblStatus Machine::submit_line(std::string_view line, double now_s) {
   advance(now_s);
   if (alarm_) return GrblStatus::system_gc_lock;
-  const ParseResult parsed = parse_block(line, config_.parse);
-  if (parsed.status != GrblStatus::ok) return parsed.status;
-  if (parsed.block.percent) return GrblStatus::ok;
-  if (!has_room()) return GrblStatus::overflow;
-
-  detail::ModalState modal = modal_;
-  detail::PlannedBlock planned;
-  if (const GrblStatus s = detail::plan_block(parsed.block, modal, planned_pos_, config_, planned);
-      s != GrblStatus::ok)
-    return s;
+  Planned p = plan_line(line);
+  if (p.status != GrblStatus::ok) return p.status;
+  if (!p.block) return GrblStatus::ok;  // `%`
+  detail::PlannedBlock& planned = *p.block;
+  // The soft-limit check comes before the wait for a free block, as in grblHAL's mc_line: a
+  // bad target alarms at once even with the planner full.
   if (config_.soft_limits && !detail::within_soft_limits(planned, config_)) {
     alarm_stop(GrblAlarm::soft_limit, now_s, accepted_ + 1);
     return GrblStatus::soft_limit;
   }
-  if (planned.program_end) {
-    // Grbl's program end resets these in the parser state as the line is read.
-    modal.motion = MotionMode::linear;
-    modal.relative = false;
-    if (modal.inverse_time) modal.feed_mm_per_min.reset();
-    modal.inverse_time = false;
-  }
-  modal_ = modal;
+  if (is_timed(planned) && !has_room()) return GrblStatus::overflow;
+  modal_ = p.modal;
   planned.seq = ++accepted_;
   planned.line = std::string(line);
   planned.submit_s = now_s;
@@ -65,10 +86,23 @@ GrblStatus Machine::submit_line(std::string_view line, double now_s) {
 }
 
 bool Machine::has_room() const { return free_blocks() > 0; }
+bool Machine::has_room_for(std::string_view line) const {
+  if (alarm_ || has_room()) return true;
+  const Planned p = plan_line(line);
+  if (p.status != GrblStatus::ok || !p.block) return true;  // answered without a block
+  if (config_.soft_limits && !detail::within_soft_limits(*p.block, config_)) return true;
+  return !is_timed(*p.block);
+}
 std::size_t Machine::free_blocks() const {
-  return config_.planner_blocks > queued_blocks() ? config_.planner_blocks - queued_blocks() : 0;
+  const std::size_t used = queued_timed_blocks();
+  return config_.planner_blocks > used ? config_.planner_blocks - used : 0;
 }
 std::size_t Machine::queued_blocks() const { return queue_.size() + (running_ ? 1 : 0); }
+std::size_t Machine::queued_timed_blocks() const {
+  const auto queued = std::count_if(queue_.begin(), queue_.end(), is_timed);
+  return static_cast<std::size_t>(queued) + (running_ && is_timed(running_->block) ? 1 : 0);
+}
+std::size_t Machine::planner_blocks() const { return config_.planner_blocks; }
 
 double Machine::fraction_at(const Running& r, double now_s) const {
   const double dt = std::max(0.0, now_s - r.seg_t0_s);

@@ -21,7 +21,10 @@ struct MachineConfig {
   AxisValues rapid_per_min{20000, 20000, 5000, 7200, 7200};  // mm/min or deg/min per axis
   double max_feed_mm_per_min = 20000;       // feeds above are clamped, as a controller does
   double hold_decel_mm_per_s2 = 500;        // feed hold deceleration
-  std::size_t planner_blocks = 100;         // queue capacity, every accepted block counts
+  // Planner capacity in timed blocks (motion and dwell), the running one included. Zero-time
+  // lines (comments, modal-only lines, M-codes) take none: grblHAL executes them in its parser
+  // and never plans a block for them.
+  std::size_t planner_blocks = 100;
   ParseParams parse;
   // Fault injection: raise `alarm_code` when block number `alarm_at_seq` (1-based count of
   // accepted blocks) starts executing.
@@ -70,7 +73,7 @@ struct PlannedBlock {
   double submit_s = 0;
   MotionMode kind = MotionMode::none;  // none: zero-time block (modal, comment, M-code)
   AxisValues start{}, target{};
-  double duration_s = 0;
+  double duration_s = 0;        // > 0: a timed block, which occupies a planner slot
   double path_length = 0;       // mm (deg for a rotary-only move); hold deceleration runs on it
   double feed_mm_per_min = 0;   // effective feed reported while it runs
   double center_x = 0, center_y = 0, radius = 0, start_angle = 0, sweep = 0;  // arcs (rad)
@@ -84,16 +87,24 @@ class Machine {
   explicit Machine(MachineConfig config);
 
   // Parse `line`, check it against the modal state and the soft limits, and queue it.
-  // The caller must only submit while has_room(). Blank / comment-only lines are queued too
-  // (zero time) so the execution log repeats the program line for line; `%` lines are not.
-  // A target outside the soft limits raises ALARM:2 (queue flushed, motion stopped) and
-  // returns soft_limit. In alarm every line is refused with system_gc_lock.
+  // Blank / comment-only / modal-only lines are queued too (zero time, no capacity) so the
+  // execution log repeats the program line for line, each line logged when it is reached;
+  // `%` lines are not queued. A target outside the soft limits raises ALARM:2 (queue flushed,
+  // motion stopped) and returns soft_limit. In alarm every line is refused with
+  // system_gc_lock. A timed block that finds the planner full is refused with overflow and
+  // changes nothing, so a caller may keep the line and try again (see has_room_for).
   GrblStatus submit_line(std::string_view line, double now_s);
-  // Capacity is planner_blocks; the running block keeps its slot until it finishes (Grbl).
-  // Submitting without room is refused with overflow and queues nothing.
+  // Capacity is planner_blocks timed blocks (motion with a non-zero length and dwell with a
+  // non-zero time); the running one keeps its slot until it finishes (Grbl).
+  // has_room(): a timed block would fit. has_room_for(line): submit_line would not refuse
+  // this line with overflow (a zero-time line, a line with an error, a soft-limit target — the
+  // last two are answered at once, as grblHAL checks them before waiting for a block).
   bool has_room() const;
-  std::size_t free_blocks() const;
-  std::size_t queued_blocks() const;
+  bool has_room_for(std::string_view line) const;
+  std::size_t free_blocks() const;          // planner_blocks − queued_timed_blocks(): Grbl's Bf
+  std::size_t queued_blocks() const;        // every queued line, zero-time ones and the running one included
+  std::size_t queued_timed_blocks() const;  // the ones that occupy the planner
+  std::size_t planner_blocks() const;       // the configured capacity ($I)
 
   // Run the time model up to now_s: finish blocks, start the next ones, emit events.
   void advance(double now_s);
@@ -145,6 +156,14 @@ class Machine {
   void stop_running(double t_s);  // cut the running block short (reset, alarm)
   void alarm_stop(GrblAlarm code, double t_s, std::uint64_t seq);
   void reset_modal();
+  // Parse and plan `line` against the current modal state without changing anything. nullopt
+  // with `status` ok: a `%` line (nothing to queue).
+  struct Planned {
+    GrblStatus status = GrblStatus::ok;
+    std::optional<detail::PlannedBlock> block;
+    detail::ModalState modal;  // the modal state after the line
+  };
+  Planned plan_line(std::string_view line) const;
 
   MachineConfig config_;
   detail::ModalState modal_;

@@ -222,8 +222,9 @@ void SimRuntime::tick_plc(double now) {
     machine_.set_estop(estop_applied_, now);
     log_.write_event(estop_applied_ ? "estop" : "estop_released", now);
   }
-  // Blocks written into the Modbus mailbox go into the same queue as the serial line's.
-  if (const auto block = plc_.pending_block(); block && machine_.has_room()) {
+  // Blocks written into the Modbus mailbox go into the same queue as the serial line's (a
+  // motion block waits for a free planner block, other blocks pass at once).
+  if (const auto block = plc_.pending_block(); block && machine_.has_room_for(block->text)) {
     if (machine_.submit_line(block->text, now) == GrblStatus::ok)
       plc_.accept_block(block->seq);
     else
@@ -281,6 +282,7 @@ nlohmann::json SimRuntime::status_json() const {
           {"accepted_blocks", machine_.accepted_blocks()},
           {"executed_blocks", machine_.executed_blocks()},
           {"queued_blocks", machine_.queued_blocks()},
+          {"queued_timed_blocks", machine_.queued_timed_blocks()},
           {"starvation", machine_.starvation_count()},
           {"lines_received", c.lines_received},
           {"bytes_received", c.bytes_received},

@@ -76,7 +76,7 @@ class XonXoffProtocol final : public CncProtocol {
       out_ += kDc1;
       xoff_ = false;
     }
-    while (!stalled_ && machine_.has_room() && take_line(now_s)) {
+    while (!stalled_ && take_line(now_s)) {
       if (check_alarm()) return;
     }
     if (xoff_ && buf_.size() < params_.low_water_bytes) {
@@ -102,13 +102,15 @@ class XonXoffProtocol final : public CncProtocol {
   enum class RxState { wait_start, program, halted };
 
   // Takes one block (EOB = LF, CR or CR LF; `%` ends the program). False when no complete
-  // block is buffered.
+  // block is buffered, or it is a motion block and the planner is full: it stays in the
+  // buffer (only motion fills the planner; other blocks pass once those before them have).
   bool take_line(double now_s) {
     const auto end = std::find_if(buf_.begin(), buf_.end(),
                                   [](char c) { return c == '\n' || c == '\r' || c == '%'; });
     if (end == buf_.end()) return false;
     const char term = *end;
     std::string line(buf_.begin(), end);
+    if (!machine_.has_room_for(line)) return false;
     buf_.erase(buf_.begin(), std::next(end));
 
     if (term == '%') {

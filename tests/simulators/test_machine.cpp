@@ -131,24 +131,39 @@ TEST(Machine, ArcTimedByItsLength) {
   EXPECT_EQ(m.submit_line("G2X0Y0I3", 10), GrblStatus::invalid_target);     // end not on the circle
 }
 
-TEST(Machine, QueueCapacityCountsEveryBlock) {
+TEST(Machine, QueueCapacityCountsOnlyTimedBlocks) {
   MachineConfig config;
-  config.planner_blocks = 3;
+  config.planner_blocks = 2;
   Machine m(config);
   ok(m, "G1X10F60", 0);  // 10 mm at 1 mm/s: runs 0-10 s and holds its slot meanwhile
-  ok(m, "(a comment counts too)", 0);
+  ok(m, "(a comment takes no block)", 0);
+  ok(m, "G94", 0);
   EXPECT_EQ(m.free_blocks(), 1u);
-  EXPECT_TRUE(m.has_room());
-  ok(m, "G1X20", 0);
   EXPECT_EQ(m.queued_blocks(), 3u);
+  EXPECT_EQ(m.queued_timed_blocks(), 1u);
+  ok(m, "G1X20", 0);
   EXPECT_FALSE(m.has_room());
+  EXPECT_EQ(m.free_blocks(), 0u);
+  // Full: a move is refused and changes nothing; zero-time lines still go in behind it.
+  EXPECT_FALSE(m.has_room_for("G1X30"));
+  EXPECT_FALSE(m.has_room_for("X30"));  // modal G1: a move too
   EXPECT_EQ(m.submit_line("G1X30", 0), GrblStatus::overflow);
-  m.advance(10.5);  // block 1 done at 10, comment at 10 (zero time), block 3 runs 10-20
-  EXPECT_EQ(m.queued_blocks(), 1u);
-  EXPECT_EQ(m.free_blocks(), 2u);
+  EXPECT_EQ(m.accepted_blocks(), 4u);
+  EXPECT_TRUE(m.has_room_for("M3"));
+  EXPECT_TRUE(m.has_room_for("G1X20"));    // already there: an empty move, no block (grblHAL)
+  EXPECT_TRUE(m.has_room_for("G4P0"));     // no time, no block
+  EXPECT_FALSE(m.has_room_for("G4P0.5"));  // a dwell takes one (our simplification)
+  EXPECT_TRUE(m.has_room_for("G1X1B5"));   // an error is answered at once, no block needed
+  ok(m, "M3", 0);
+  ok(m, "(another comment)", 0);
+  EXPECT_EQ(m.free_blocks(), 0u);
+  m.advance(10.5);  // block 1 done at 10, the comment and G94 at 10 (zero time), X20 runs 10-20
+  EXPECT_EQ(m.queued_timed_blocks(), 1u);
+  EXPECT_EQ(m.free_blocks(), 1u);
+  EXPECT_EQ(m.queued_blocks(), 3u);  // X20 running, M3 and the comment behind it
   EXPECT_EQ(m.submit_line("%", 10.5), GrblStatus::ok);  // `%` is not queued
-  EXPECT_EQ(m.queued_blocks(), 1u);
-  EXPECT_EQ(m.accepted_blocks(), 3u);
+  EXPECT_EQ(m.accepted_blocks(), 6u);
+  EXPECT_EQ(m.planner_blocks(), 2u);
 }
 
 TEST(Machine, FeedHoldDeceleratesHoldsAndResumes) {
