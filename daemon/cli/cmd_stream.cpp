@@ -109,7 +109,9 @@ int run_stream(const StreamOptions& o) {
     }
   }
 
-  drivers::CutJob job(*link, cell.get(), *program);
+  drivers::CutJobSettings job_settings;
+  job_settings.wait_for_idle = o.protocol != "xonxoff";  // a drip feed reports no status
+  drivers::CutJob job(*link, cell.get(), *program, job_settings);
   KeyboardControl keys;  // raw stdin while streaming when it is a terminal
   ProgressLine progress(program->size(), !o.json);
   std::signal(SIGINT, on_sigint);

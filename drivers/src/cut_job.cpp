@@ -155,7 +155,8 @@ CutReport CutJob::stream_from(std::size_t from, std::vector<std::string> preambl
     int idle_reports = 0;
     std::size_t last_seen = seen;
     const auto deadline = Clock::now() + std::chrono::duration<double>(settings_.finish_timeout_s);
-    while (Clock::now() < deadline && !stopping_) {
+    if (!settings_.wait_for_idle) idle_reports = 2;
+    while (settings_.wait_for_idle && Clock::now() < deadline && !stopping_) {
       const LinkProgress p = link_.progress();
       if (p.statuses_received != last_seen && p.last_status) {
         last_seen = p.statuses_received;

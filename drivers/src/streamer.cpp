@@ -28,6 +28,7 @@ double seconds_between(Clock::time_point a, Clock::time_point b) {
 // behind it reaches the controller within it (plus one chunk).
 constexpr double kPacingBacklogS = 0.015;
 constexpr double kTickS = 0.005;
+constexpr double kBannerWaitS = 0.5;
 
 }  // namespace
 
@@ -59,6 +60,8 @@ struct Streamer::Impl {
   std::size_t span_size = 0, first_index = 0;
   bool error_lock_pending = false;
   std::atomic<int> resets_seen{0};    // banners while not streaming (recover() waits for one)
+  bool awaiting_banner = false;
+  Clock::time_point connected_at{};
   int idle_with_lines_in_flight = 0;  // consecutive Idle reports while we wait for acks
   std::size_t accepted_at_last_status = 0;
 
@@ -102,9 +105,20 @@ struct Streamer::Impl {
       if (!opened) return finish(opened.error());
       transport = std::move(*opened);
       spdlog::info("link: connected {}", transport->describe());
+      // Many controllers greet a new connection with their banner (a DTR reset, a telnet
+      // greeting). Anything sent before it may be lost or answered out of turn, so the
+      // handshake waits for the banner, or for a short quiet period when none comes.
+      awaiting_banner = true;
+      connected_at = Clock::now();
       read_more();
     }
     pending_span = std::move(span);
+    schedule_tick();
+    if (awaiting_banner) return;  // the handshake follows the banner (or the quiet period)
+    send_handshake_or_load();
+  }
+
+  void send_handshake_or_load() {
     const std::string hello = protocol->handshake_done() ? std::string() : protocol->handshake();
     if (!hello.empty()) {
       handshaking = true;
@@ -113,7 +127,6 @@ struct Streamer::Impl {
     } else {
       load_pending();
     }
-    schedule_tick();
   }
 
   void load_pending() {
@@ -190,6 +203,11 @@ struct Streamer::Impl {
         finish(LinkError{LinkErrorCode::controller_alarm, fmt::format("alarm {}: {}", a->code, a->meaning)});
       } else if (const auto* reset = std::get_if<ControllerReset>(&event)) {
         resets_seen.fetch_add(1);
+        if (awaiting_banner) {
+          awaiting_banner = false;
+          if (streaming) send_handshake_or_load();
+          continue;
+        }
         // A board that resets when its port opens (DTR on an Arduino Grbl) eats the first
         // handshake: ask again once it has printed its banner.
         if (handshaking) send_realtime_bytes(protocol->handshake());
@@ -320,6 +338,10 @@ struct Streamer::Impl {
 
   void on_tick() {
     const auto now = Clock::now();
+    if (awaiting_banner && seconds_between(connected_at, now) > kBannerWaitS) {
+      awaiting_banner = false;
+      if (streaming) send_handshake_or_load();
+    }
     if (handshaking && seconds_between(handshake_started, now) > settings.handshake_timeout_s) {
       finish(LinkError{LinkErrorCode::timeout,
                        fmt::format("{}: no answer to the handshake within {} s",

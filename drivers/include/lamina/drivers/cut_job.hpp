@@ -23,6 +23,9 @@ struct CutJobSettings {
   double finish_timeout_s = 24 * 3600;  // everything accepted → the machine is Idle
   double safe_z_mm = 10;
   std::size_t planner_blocks = 0;   // 0: as the controller reported ([OPT:]); else configured
+  // Wait for the controller to report Idle after the last line (needs status reports). A drip
+  // feed has none: its cut is done, as far as the link can tell, when the last byte is out.
+  bool wait_for_idle = true;
 };
 
 enum class CutState { ready, preparing, cutting, stopping, stopped, completed, failed };
