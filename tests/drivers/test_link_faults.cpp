@@ -20,6 +20,9 @@ struct FaultCase {
   std::vector<std::string> sim_flags;
   std::set<std::string> reasons;  // acceptable reason codes
   const char* message_has;        // a word the reason's message must carry
+  // A lost ok only narrows the window: every line still runs, and the link sees the loss when
+  // the controller goes idle with a line unacknowledged.
+  bool program_may_finish = false;
 };
 
 void PrintTo(const FaultCase& c, std::ostream* os) { *os << c.name; }
@@ -65,14 +68,14 @@ TEST_P(LinkFault, StopsSafelyWithAReasonAndDoesNotResume) {
   const auto b = sim::testing::control_status(sim.control_port());
   EXPECT_EQ(a["position"], b["position"]) << "the machine moved after the stop";
   EXPECT_EQ(executed_lines(dir.file("exec.jsonl"), false).size(), before) << "nothing ran after the stop";
-  EXPECT_LT(executed_lines(dir.file("exec.jsonl")).size(), program.size());
+  if (!c.program_may_finish) EXPECT_LT(executed_lines(dir.file("exec.jsonl")).size(), program.size());
 }
 
 INSTANTIATE_TEST_SUITE_P(
     EveryInjectedFault, LinkFault,
     ::testing::Values(
         FaultCase{"garbled_bytes", {"--garble", "0.003", "--seed", "3"}, {"controller_error", "protocol_error", "timeout", "controller_alarm"}, ""},
-        FaultCase{"lost_ok", {"--drop-ok", "120"}, {"protocol_error"}, "acknowledgement lost"},
+        FaultCase{"lost_ok", {"--drop-ok", "120"}, {"protocol_error"}, "acknowledgement lost", true},
         FaultCase{"unplugged", {"--unplug-at-line", "200"}, {"io_error"}, "cnc"},
         FaultCase{"alarm", {"--alarm-at-line", "150"}, {"controller_alarm"}, "alarm 1"},
         FaultCase{"estop", {"--estop-at", "1.5"}, {"interlock", "controller_alarm"}, "stop"},
