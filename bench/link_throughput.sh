@@ -16,8 +16,8 @@ trap 'kill $(jobs -p) 2>/dev/null || true; rm -rf "$work"' EXIT
 
 program() {  # program LINES STEP_MM FEED_MM_PER_MIN
   awk -v n="$1" -v step="$2" -v f="$3" 'BEGIN {
-    print "G21G90G94"; print "(CONTOUR 0 L1-1 OUTLINE 0 PASS 0 FREES)"; print "G0X10Y10Z10A0C0"; print "Z0"; print "M3";
-    x = 10; y = 10;
+    print "G21G90G94"; print "(CONTOUR 0 L1-1 OUTLINE 0 PASS 0 FREES)"; print "G0X300Y300Z10A0C0"; print "Z0"; print "M3";
+    x = 300; y = 300;
     for (i = 1; i <= n; i++) {
       x += step * cos(i * 0.002); y += step * sin(i * 0.002);
       if (i % 4 == 0) printf "G93G1X%.3fY%.3fA%.3fC%.3fF%.0f\nG94\n", x, y, 10 * sin(i * 0.001), 0.05 * i, f / step;
@@ -33,12 +33,13 @@ run() {  # run NAME PROGRAM TIME_SCALE
   "$sim" --link "$link" --log "$work/$1.jsonl" --control 127.0.0.1:0 --time-scale "$3" > "$work/$1.ready" &
   for _ in $(seq 50); do [[ -s $work/$1.ready ]] && break; sleep 0.1; done
   local control; control=$(sed -n 's/.*"control_port":\([0-9]*\).*/\1/p' "$work/$1.ready")
-  "$lamina" stream "$2" --port "$link" --protocol grbl --json > "$work/$1.json"
+  "$lamina" stream "$2" --port "$link" --protocol grbl --json > "$work/$1.json" 2> "$work/$1.err" || true
   local status; status=$(exec 3<>/dev/tcp/127.0.0.1/"$control"; echo status >&3; head -1 <&3)
   kill %% 2>/dev/null || true
   wait 2>/dev/null || true
   echo "== $1: $(wc -l < "$2") lines, $(wc -c < "$2") bytes"
   echo "   stream: $(cat "$work/$1.json")"
+  grep -v "\[info\]" "$work/$1.err" | head -5 || true
   echo "   sim:    $(echo "$status" | grep -o '"starvation":[0-9]*'), $(echo "$status" | grep -o '"executed_blocks":[0-9]*')"
 }
 

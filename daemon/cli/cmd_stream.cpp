@@ -14,6 +14,8 @@
 #include <boost/asio/io_context.hpp>
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
 
 #include "commands.hpp"
 #include "lamina/drivers/cell_io.hpp"
@@ -62,6 +64,8 @@ std::atomic<bool> g_interrupted{false};
 extern "C" void on_sigint(int) { g_interrupted = true; }
 
 int run_stream(const StreamOptions& o) {
+  // Logs go to stderr: stdout carries the summary (--json) a script reads.
+  spdlog::set_default_logger(spdlog::stderr_color_mt("link"));
   auto program = read_program(o.program);
   if (!program) {
     fmt::print(stderr, "lamina stream: {}\n", program.error());

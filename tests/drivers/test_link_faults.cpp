@@ -68,7 +68,9 @@ TEST_P(LinkFault, StopsSafelyWithAReasonAndDoesNotResume) {
   const auto b = sim::testing::control_status(sim.control_port());
   EXPECT_EQ(a["position"], b["position"]) << "the machine moved after the stop";
   EXPECT_EQ(executed_lines(dir.file("exec.jsonl"), false).size(), before) << "nothing ran after the stop";
-  if (!c.program_may_finish) EXPECT_LT(executed_lines(dir.file("exec.jsonl")).size(), program.size());
+  if (!c.program_may_finish) {
+    EXPECT_LT(executed_lines(dir.file("exec.jsonl")).size(), program.size());
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(
