@@ -83,6 +83,10 @@ int run_stream(const StreamOptions& o) {
     std::tie(s.host, s.port) = split_host_port(o.modbus, "--modbus");
     s.status_period_s = 1.0 / o.status_hz;
     link = std::make_unique<drivers::ModbusBlockLink>(s);
+    drivers::CellIoSettings cs;  // the same PLC minds the pump and interlocks
+    cs.host = s.host;
+    cs.port = s.port;
+    cell = std::make_unique<drivers::CellIo>(cs);
   } else {
     if (o.port.empty() == o.tcp.empty()) {
       fmt::print(stderr, "lamina stream: give --port DEVICE or --tcp HOST:PORT\n");

@@ -56,6 +56,7 @@ struct CellIo::Impl {
   std::condition_variable wake;
   std::deque<Command> commands;
   std::atomic<bool> jet_off_requested{false};
+  std::atomic<bool> feed_hold_requested{false};
   std::atomic<bool> stopping{false};
   std::optional<CellFaultReport> fault;
   std::function<void(const CellFaultReport&)> callback;
@@ -80,6 +81,10 @@ struct CellIo::Impl {
   void run() {
     while (true) {
       if (jet_off_requested.exchange(false)) write_jet_off("jet_off() requested");
+      if (feed_hold_requested.exchange(false)) {
+        if (auto r = client.write_bit(pm::kCoilCncFeedHold, true); !r)
+          log->warn("feed hold through the PLC: {}", r.error().message);
+      }
       if (stopping) break;
       std::optional<Command> command;
       {
@@ -97,7 +102,8 @@ struct CellIo::Impl {
       if (monitoring && Clock::now() >= next_poll) poll();
       const auto deadline = monitoring ? std::min(next_heartbeat, next_poll) : Clock::now() + std::chrono::seconds(1);
       std::unique_lock lock(mutex);
-      wake.wait_until(lock, deadline, [this] { return !commands.empty() || jet_off_requested || stopping; });
+      wake.wait_until(lock, deadline,
+                      [this] { return !commands.empty() || jet_off_requested || feed_hold_requested || stopping; });
     }
     // Best effort on the way out: the jet must not stay consented with nobody watching.
     if (client.connected() || monitoring) {
@@ -283,6 +289,11 @@ std::expected<void, LinkError> CellIo::finish_cut() { return impl_->submit(Impl:
 
 void CellIo::jet_off() {
   impl_->jet_off_requested = true;
+  impl_->wake.notify_all();
+}
+
+void CellIo::feed_hold() {
+  impl_->feed_hold_requested = true;
   impl_->wake.notify_all();
 }
 

@@ -53,7 +53,10 @@ void CutJob::continue_motion() { link_.request(RealtimeCommand::resume); }
 
 void CutJob::abort(std::string why) {
   // Jet first: the PLC path does not wait for anything queued on the serial line.
-  if (cell_) cell_->jet_off();
+  if (cell_) {
+    cell_->jet_off();
+    cell_->feed_hold();
+  }
   link_.request(RealtimeCommand::feed_hold);
   link_.stop(LinkError{LinkErrorCode::cancelled, std::move(why)});
 }
@@ -64,6 +67,7 @@ CutReport CutJob::run() {
     cell_->on_fault([this](const CellFaultReport& fault) {
       // The PLC already dropped the jet; hold the motion and stop the stream.
       cell_->jet_off();
+      cell_->feed_hold();
       link_.request(RealtimeCommand::feed_hold);
       link_.stop(LinkError{LinkErrorCode::interlock, fault.message});
     });
@@ -193,7 +197,10 @@ void CutJob::stop_safely(LinkError why) {
   stopping_ = true;
   set_state(CutState::stopping);
   spdlog::warn("cut: stopping: {}", why.message);
-  if (cell_) cell_->jet_off();
+  if (cell_) {
+    cell_->jet_off();
+    cell_->feed_hold();  // a drip feed has no real-time hold on its line
+  }
   link_.request(RealtimeCommand::feed_hold);
   // Wait for a report asked after the hold that says the axes stand still.
   const std::size_t before = link_.progress().statuses_received;
@@ -220,6 +227,9 @@ void CutJob::stop_safely(LinkError why) {
   }
   report_.first_unfinished_line = first_unfinished_line(program_, accepted, queued);
   report_.reason = why;
+  // The controller often speaks first (ALARM, NAK) about what the PLC knows the cause of.
+  if (cell_ && why.code != LinkErrorCode::interlock)
+    if (const auto cell_fault = cell_->fault()) report_.reason->message += " (cell: " + cell_fault->message + ")";
   report_.last_status = still ? still : report_.last_status;
   if (auto plan = plan_resume(program_, report_.first_unfinished_line, settings_.safe_z_mm)) {
     report_.resume = *plan;

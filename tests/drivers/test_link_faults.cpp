@@ -17,6 +17,7 @@ namespace {
 
 struct FaultCase {
   const char* name;
+  const char* protocol;
   std::vector<std::string> sim_flags;
   std::set<std::string> reasons;  // acceptable reason codes
   const char* message_has;        // a word the reason's message must carry
@@ -42,13 +43,17 @@ TEST_P(LinkFault, StopsSafelyWithAReasonAndDoesNotResume) {
   const FaultCase& c = GetParam();
   TempDir dir;
   const auto program = contour_program(4, 150);
+  const std::string protocol = c.protocol;
   std::vector<std::string> args{"--link", dir.file("cnc"), "--log", dir.file("exec.jsonl"), "--modbus", "127.0.0.1:0",
                                 "--control", "127.0.0.1:0", "--pressure-ramp", "0.2", "--time-scale", "2"};
+  if (protocol == "xonxoff")
+    args.insert(args.end(), {"--personality", "xonxoff", "--rx-buffer", "256", "--planner-blocks", "8"});
   args.insert(args.end(), c.sim_flags.begin(), c.sim_flags.end());
   SimProcess sim(args);
   const auto t0 = std::chrono::steady_clock::now();
-  const CliRun run = run_lamina_stream(fmt::format("'{}' --port '{}' --protocol grbl --modbus 127.0.0.1:{}",
-                                                   write_program(dir, program), dir.file("cnc"), sim.modbus_port()));
+  const std::string port = protocol == "modbus" ? "" : fmt::format("--port '{}'", dir.file("cnc"));
+  const CliRun run = run_lamina_stream(fmt::format("'{}' {} --protocol {} --modbus 127.0.0.1:{}",
+                                                   write_program(dir, program), port, protocol, sim.modbus_port()));
   const double took_s = sim::testing::seconds_since(t0);
   EXPECT_EQ(run.exit_code, 1) << run.output;
   ASSERT_EQ(run.summary["state"], "stopped") << run.output;
@@ -76,13 +81,28 @@ TEST_P(LinkFault, StopsSafelyWithAReasonAndDoesNotResume) {
 INSTANTIATE_TEST_SUITE_P(
     EveryInjectedFault, LinkFault,
     ::testing::Values(
-        FaultCase{"garbled_bytes", {"--garble", "0.003", "--seed", "3"}, {"controller_error", "protocol_error", "timeout", "controller_alarm"}, ""},
-        FaultCase{"lost_ok", {"--drop-ok", "120"}, {"protocol_error"}, "acknowledgement lost", true},
-        FaultCase{"unplugged", {"--unplug-at-line", "200"}, {"io_error"}, "cnc"},
-        FaultCase{"alarm", {"--alarm-at-line", "150"}, {"controller_alarm"}, "alarm 1"},
-        FaultCase{"estop", {"--estop-at", "1.5"}, {"interlock", "controller_alarm"}, "stop"},
-        FaultCase{"pressure_drop", {"--pressure-drop-at", "1.5"}, {"interlock"}, "pressure"},
-        FaultCase{"stall", {"--stall-at", "1.5", "--stall-for", "4000"}, {"timeout"}, "stalled"}),
+        FaultCase{"garbled_bytes", "grbl", {"--garble", "0.003", "--seed", "3"}, {"controller_error", "protocol_error", "timeout", "controller_alarm"}, ""},
+        FaultCase{"lost_ok", "grbl", {"--drop-ok", "120"}, {"protocol_error"}, "acknowledgement lost", true},
+        FaultCase{"unplugged", "grbl", {"--unplug-at-line", "200"}, {"io_error"}, "cnc"},
+        FaultCase{"alarm", "grbl", {"--alarm-at-line", "150"}, {"controller_alarm"}, "alarm 1"},
+        FaultCase{"estop", "grbl", {"--estop-at", "1.5"}, {"interlock", "controller_alarm"}, "stop"},
+        FaultCase{"pressure_drop", "grbl", {"--pressure-drop-at", "1.5"}, {"interlock"}, "pressure"},
+        FaultCase{"stall", "grbl", {"--stall-at", "1.5", "--stall-for", "4000"}, {"timeout"}, "stalled"}),
+    [](const ::testing::TestParamInfo<FaultCase>& info) { return std::string(info.param.name); });
+
+// The other protocols, on the faults their paths differ in: the controller's own alarm, the
+// cell's interlocks (for a drip feed the PLC's feed-hold button is the only hold), a lost link.
+INSTANTIATE_TEST_SUITE_P(
+    OtherProtocols, LinkFault,
+    ::testing::Values(
+        FaultCase{"send_response_alarm", "send-response", {"--alarm-at-line", "150"}, {"controller_alarm"}, "alarm 1"},
+        FaultCase{"send_response_unplugged", "send-response", {"--unplug-at-line", "200"}, {"io_error"}, "cnc"},
+        FaultCase{"xonxoff_alarm", "xonxoff", {"--alarm-at-line", "150"}, {"controller_alarm"}, "nak"},
+        FaultCase{"xonxoff_pressure_drop", "xonxoff", {"--pressure-drop-at", "1.5"}, {"interlock"}, "pressure"},
+        FaultCase{"xonxoff_estop", "xonxoff", {"--estop-at", "1.5"}, {"interlock", "controller_alarm"}, "stop"},
+        FaultCase{"modbus_alarm", "modbus", {"--alarm-at-line", "150"}, {"controller_alarm"}, "alarm"},
+        FaultCase{"modbus_pressure_drop", "modbus", {"--pressure-drop-at", "1.5"}, {"interlock"}, "pressure"},
+        FaultCase{"modbus_estop", "modbus", {"--estop-at", "1.5"}, {"interlock", "controller_alarm"}, "stop"}),
     [](const ::testing::TestParamInfo<FaultCase>& info) { return std::string(info.param.name); });
 
 }  // namespace

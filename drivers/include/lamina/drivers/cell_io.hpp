@@ -67,6 +67,9 @@ class CellIo {
   // Worst case on a healthy link: one response timeout (the request in flight finishes first).
   // During prepare_cut it also aborts the preparation (cancelled; the cell is switched off).
   void jet_off();
+  // The PLC's feed-hold button (coil cnc_feed_hold): the motion's independent stop for
+  // controllers whose line has no real-time hold (a drip-fed Fanuc). Right after jet_off().
+  void feed_hold();
   // After the cut (or a stop): jet off, abrasive off, pump to idle (pump_enable = 0). Blocking.
   std::expected<void, LinkError> finish_cut();
   // While a cut is prepared, the first fault seen (sticky until the next prepare_cut); the
