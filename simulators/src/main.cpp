@@ -93,6 +93,9 @@ int main(int argc, char** argv) {
     if (!soft_max.empty()) o.machine.soft_max = parse_axes(soft_max, "--soft-max");
     if (no_soft_limits) o.machine.soft_limits = false;
     if (heartbeat_timeout_ms) o.plc.heartbeat_timeout_s = *heartbeat_timeout_ms / 1000.0;
+    // The PLC runs on simulated time, but its watchdog supervises a host that runs on the wall
+    // clock (like the baud): the timeout is wall milliseconds, so it stretches with the scale.
+    o.plc.heartbeat_timeout_s *= o.time_scale;
     if (drop_ok) o.grbl.faults.drop_ok_index = o.xonxoff.faults.drop_ok_index = drop_ok;
     if (alarm_at_line) o.machine.alarm_at_seq = alarm_at_line;
     if (o.faults.garble_probability < 0 || o.faults.garble_probability > 1)
