@@ -57,6 +57,7 @@ struct CellIo::Impl {
   std::deque<Command> commands;
   std::atomic<bool> jet_off_requested{false};
   std::atomic<bool> feed_hold_requested{false};
+  std::atomic<bool> cnc_reset_requested{false};
   std::atomic<bool> stopping{false};
   std::optional<CellFaultReport> fault;
   std::function<void(const CellFaultReport&)> callback;
@@ -81,6 +82,9 @@ struct CellIo::Impl {
   void run() {
     while (true) {
       if (jet_off_requested.exchange(false)) write_jet_off("jet_off() requested");
+      if (cnc_reset_requested.exchange(false)) {
+        if (auto r = client.write_bit(pm::kCoilCncReset, true); !r) log->warn("CNC reset through the PLC: {}", r.error().message);
+      }
       if (feed_hold_requested.exchange(false)) {
         if (auto r = client.write_bit(pm::kCoilCncFeedHold, true); !r)
           log->warn("feed hold through the PLC: {}", r.error().message);
@@ -103,7 +107,9 @@ struct CellIo::Impl {
       const auto deadline = monitoring ? std::min(next_heartbeat, next_poll) : Clock::now() + std::chrono::seconds(1);
       std::unique_lock lock(mutex);
       wake.wait_until(lock, deadline,
-                      [this] { return !commands.empty() || jet_off_requested || feed_hold_requested || stopping; });
+                      [this] { return !commands.empty() || jet_off_requested || feed_hold_requested || cnc_reset_requested ||
+                             stopping;
+                    });
     }
     // Best effort on the way out: the jet must not stay consented with nobody watching.
     if (client.connected() || monitoring) {
@@ -125,7 +131,7 @@ struct CellIo::Impl {
   Result read_inputs() {
     auto bits = client.read_input_bits(0, pm::kInputCount);
     if (!bits) return std::unexpected(bits.error());
-    auto regs = client.read_input_registers(0, pm::kInAlarmCode + 1);
+    auto regs = client.read_input_registers(0, pm::kInExecutedHigh + 2);
     if (!regs) return std::unexpected(regs.error());
     std::lock_guard lock(mutex);
     decode_cell_inputs(*bits, *regs, status);
@@ -289,6 +295,11 @@ std::expected<void, LinkError> CellIo::finish_cut() { return impl_->submit(Impl:
 
 void CellIo::jet_off() {
   impl_->jet_off_requested = true;
+  impl_->wake.notify_all();
+}
+
+void CellIo::reset_cnc() {
+  impl_->cnc_reset_requested = true;
   impl_->wake.notify_all();
 }
 

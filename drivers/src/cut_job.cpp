@@ -88,6 +88,11 @@ CutReport CutJob::resume() {
     if (report_.state != CutState::stopped || !report_.resume) return report_;
     plan = report_.resume;
   }
+  if (!link_.can_reset() && cell_) {
+    // The queue a held drip feed still holds must go before the program restarts.
+    cell_->reset_cnc();
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  }
   if (auto error = link_.recover(settings_.stop_timeout_s)) {
     std::lock_guard lock(mutex_);
     report_.reason = *error;
@@ -104,10 +109,28 @@ CutReport CutJob::resume() {
   return stream_from(plan->restart_index, plan->preamble);
 }
 
+std::optional<std::uint64_t> CutJob::executed_blocks(bool fresh) {
+  // Let one more report come in (the link's status period, the PLC's poll) so the count is
+  // not older than the moment we care about.
+  if (fresh) {
+    const std::size_t before = link_.progress().statuses_received;
+    const auto deadline = Clock::now() + std::chrono::milliseconds(600);
+    while (Clock::now() < deadline && link_.progress().statuses_received < before + 2 && !cell_)
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    if (cell_) std::this_thread::sleep_for(std::chrono::milliseconds(150));
+  }
+  if (const auto p = link_.progress(); p.last_status && p.last_status->executed_blocks) return p.last_status->executed_blocks;
+  if (cell_) return cell_->status().cnc_executed_blocks;
+  return std::nullopt;
+}
+
 CutReport CutJob::stream_from(std::size_t from, std::vector<std::string> preamble) {
   stopping_ = false;
   set_state(CutState::cutting);
   const auto started = Clock::now();
+  // The machine stands still here (fresh, or recovered): its count is this attempt's base.
+  executed_base_ = executed_blocks(true);
+  preamble_lines_ = preamble.size();
   if (!preamble.empty()) {
     link_.start(LineSpan{std::move(preamble), 0}, {});
     const auto outcome = link_.wait(settings_.stop_timeout_s * 4);
@@ -215,6 +238,15 @@ void CutJob::stop_safely(LinkError why) {
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
   const LinkProgress p = link_.progress();
+  // (plain value + flag: g++ 12 warns falsely about an optional here)
+  std::uint64_t executed_now = 0;
+  bool have_executed = false;
+  if (executed_base_) {
+    if (const auto e = executed_blocks(true)) {
+      executed_now = *e;
+      have_executed = true;
+    }
+  }
   std::lock_guard lock(mutex_);
   std::size_t accepted = accepted_at_status_;
   std::size_t queued = queued_at_status_.value_or(program_.size());  // unknown: assume all may be queued
@@ -226,6 +258,15 @@ void CutJob::stop_safely(LinkError why) {
     queued = static_cast<std::size_t>(std::max(0, *capacity - *still->planner_blocks_free));
   }
   report_.first_unfinished_line = first_unfinished_line(program_, accepted, queued);
+  const bool held_with_queue = still && still->state == ControllerState::hold && capacity && still->planner_blocks_free;
+  if (!held_with_queue && executed_base_) {
+    // No queue to read (a drip feed, the mailbox, an alarm that flushed it): the CNC's own
+    // count of finished blocks says which line it was on.
+    if (have_executed && executed_now >= *executed_base_ + preamble_lines_) {
+      const std::size_t ran = static_cast<std::size_t>(executed_now - *executed_base_ - preamble_lines_);
+      report_.first_unfinished_line = std::min(program_.size(), span_first_ + ran);
+    }
+  }
   report_.reason = why;
   // The controller often speaks first (ALARM, NAK) about what the PLC knows the cause of.
   if (cell_ && why.code != LinkErrorCode::interlock)

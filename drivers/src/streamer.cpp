@@ -418,6 +418,8 @@ std::optional<LinkOutcome> Streamer::wait(double timeout_s) {
   return impl_->outcome;
 }
 
+bool Streamer::can_reset() const { return !impl_->protocol->realtime(RealtimeCommand::reset).empty(); }
+
 std::optional<LinkError> Streamer::recover(double timeout_s) {
   const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(timeout_s));
   const std::string reset = impl_->protocol->realtime(RealtimeCommand::reset);

@@ -5,6 +5,7 @@
 #include <thread>
 
 #include "lamina/drivers/cut_job.hpp"
+#include "lamina/drivers/modbus_block_link.hpp"
 #include "lamina/drivers/streamer.hpp"
 #include "link_test_support.hpp"
 
@@ -114,6 +115,65 @@ TEST(CutJobResume, AfterAFeedHoldStopTheQueueTellsExactlyWhatRan) {
   ASSERT_EQ(r.state, CutState::completed) << (r.reason ? r.reason->message : "");
   expect_resumed_once_from_contour_start(records(dir.file("exec.jsonl")), program, restart);
 }
+
+}  // namespace
+}  // namespace lamina::drivers::testing
+
+namespace lamina::drivers::testing {
+namespace {
+
+// A controller without a status report of its own (a drip feed) or fed through the PLC: the
+// PLC's count of executed blocks places the stop, its buttons hold and reset the CNC.
+void pressure_drop_then_resume(const std::string& protocol) {
+  TempDir dir;
+  const auto program = contour_program(4, 100);
+  std::vector<std::string> args{"--link", dir.file("cnc"), "--log", dir.file("exec.jsonl"), "--control", "127.0.0.1:0",
+                                "--modbus", "127.0.0.1:0", "--pressure-ramp", "0.2", "--time-scale", "2"};
+  if (protocol == "xonxoff")
+    args.insert(args.end(), {"--personality", "xonxoff", "--rx-buffer", "256", "--planner-blocks", "8"});
+  SimProcess sim(args);
+  std::unique_ptr<MachineLink> link;
+  if (protocol == "xonxoff") {
+    StreamerSettings settings;
+    settings.status_period_s = 0;
+    settings.pace_bytes_per_s = 11520;
+    const std::string path = dir.file("cnc");
+    link = std::make_unique<Streamer>(
+        [path](boost::asio::io_context& io) { return open_serial(io, path, SerialSettings{}); },
+        make_xonxoff_protocol(), settings);
+  } else {
+    ModbusBlockSettings settings;
+    settings.port = sim.modbus_port();
+    link = std::make_unique<ModbusBlockLink>(settings);
+  }
+  CellIoSettings cell_settings;
+  cell_settings.port = sim.modbus_port();
+  CellIo cell(cell_settings);
+  CutJobSettings job_settings;
+  job_settings.wait_for_idle = protocol != "xonxoff";
+  CutJob job(*link, &cell, program, job_settings);
+  std::thread fault([&] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(2000));
+    sim::testing::control(sim.control_port(), "pressure drop");
+  });
+  CutReport r = job.run();
+  fault.join();
+  ASSERT_EQ(r.state, CutState::stopped) << (r.reason ? r.reason->message : "");
+  EXPECT_EQ(r.reason->code, LinkErrorCode::interlock) << r.reason->message;
+  ASSERT_TRUE(r.resume);
+  EXPECT_GT(r.first_unfinished_line, 0u) << "the PLC's executed count placed the stop";
+  const std::size_t restart = r.resume->restart_index;
+  EXPECT_EQ(sim::testing::control(sim.control_port(), "pressure restore"), "ok");
+  r = job.resume();
+  ASSERT_EQ(r.state, CutState::completed) << (r.reason ? r.reason->message : "");
+  ASSERT_TRUE(sim::testing::wait_status(sim.control_port(), [](const nlohmann::json& st) {
+    return st["queued_blocks"] == 0 && st["state"] == "idle";
+  }, 60));
+  expect_resumed_once_from_contour_start(records(dir.file("exec.jsonl")), program, restart);
+}
+
+TEST(CutJobResume, DripFeedStoppedByThePlcResumesFromTheContourStart) { pressure_drop_then_resume("xonxoff"); }
+TEST(CutJobResume, MailboxStoppedByThePlcResumesFromTheContourStart) { pressure_drop_then_resume("modbus"); }
 
 }  // namespace
 }  // namespace lamina::drivers::testing

@@ -5,6 +5,7 @@
 // the heartbeat going and watches pressure and interlocks; it owns the jet's independent off
 // path (the jet_on coil). Transport errors (ETIMEDOUT, EIO…) lead to bounded, logged reconnects.
 #include <chrono>
+#include <cstdint>
 #include <expected>
 #include <functional>
 #include <memory>
@@ -49,6 +50,9 @@ struct CellStatus {
   double abrasive_g_per_min = 0;
   int alarm_code = 0;
   int reconnects = 0;
+  // The CNC as the PLC sees it: blocks finished since power-on (comments included, one per
+  // program line) — how far a controller without a status report of its own has got.
+  std::optional<std::uint64_t> cnc_executed_blocks;
 };
 
 class CellIo {
@@ -70,6 +74,8 @@ class CellIo {
   // The PLC's feed-hold button (coil cnc_feed_hold): the motion's independent stop for
   // controllers whose line has no real-time hold (a drip-fed Fanuc). Right after jet_off().
   void feed_hold();
+  // The PLC's reset button (coil cnc_reset): flushes a controller that has no reset on its line.
+  void reset_cnc();
   // After the cut (or a stop): jet off, abrasive off, pump to idle (pump_enable = 0). Blocking.
   std::expected<void, LinkError> finish_cut();
   // While a cut is prepared, the first fault seen (sticky until the next prepare_cut); the

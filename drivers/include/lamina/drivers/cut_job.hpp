@@ -6,6 +6,7 @@
 // start of the contour that was being cut (resume_point.hpp).
 #include <atomic>
 #include <cstddef>
+#include <cstdint>
 #include <functional>
 #include <mutex>
 #include <optional>
@@ -65,6 +66,8 @@ class CutJob {
 
  private:
   CutReport stream_from(std::size_t from, std::vector<std::string> preamble);
+  // Blocks the CNC has finished, from the link's status or the PLC's (nullopt: neither says).
+  std::optional<std::uint64_t> executed_blocks(bool fresh);
   void stop_safely(LinkError why);
   void set_state(CutState state);
 
@@ -81,6 +84,10 @@ class CutJob {
   // Acknowledged lines and planner occupancy at the last status report (for the resume point).
   std::size_t accepted_at_status_ = 0;
   std::optional<std::size_t> queued_at_status_;
+  // The CNC's executed-block count before this attempt's first line, and the preamble length:
+  // program line from + k has run once the count passes base + preamble + k.
+  std::optional<std::uint64_t> executed_base_;
+  std::size_t preamble_lines_ = 0;
 };
 
 }  // namespace lamina::drivers

@@ -53,6 +53,8 @@ class MachineLink {
   // After a stop, before streaming from a resume point: clear the controller's queue and its
   // alarm or error lock (grbl: soft reset, then $X). Blocking.
   virtual std::optional<LinkError> recover(double timeout_s) = 0;
+  // Whether recover() can reset the controller at all (a drip feed's line cannot: the PLC can).
+  virtual bool can_reset() const = 0;
   // Blocks until the last start() finished; nullopt on timeout.
   virtual std::optional<LinkOutcome> wait(double timeout_s) = 0;
 };

@@ -30,6 +30,7 @@ class ModbusBlockLink final : public MachineLink {
   void stop(LinkError why) override;
   LinkProgress progress() const override;
   std::optional<LinkError> recover(double timeout_s) override;
+  bool can_reset() const override { return true; }  // the PLC's reset button
   std::optional<LinkOutcome> wait(double timeout_s) override;
 
  private:

@@ -40,6 +40,7 @@ class Streamer final : public MachineLink {
   void stop(LinkError why) override;
   LinkProgress progress() const override;
   std::optional<LinkError> recover(double timeout_s) override;
+  bool can_reset() const override;
   std::optional<LinkOutcome> wait(double timeout_s) override;
 
   RealtimeLatency realtime_latency() const;
