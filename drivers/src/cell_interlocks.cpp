@@ -17,6 +17,7 @@ void decode_cell_inputs(std::span<const std::uint8_t> inputs, std::span<const st
   status.pressure_mpa = mpa_from_01mpa(registers[pm::kInPressure]);
   status.abrasive_g_per_min = registers[pm::kInAbrasiveFlow];
   status.alarm_code = registers[pm::kInAlarmCode];
+  if (registers.size() > static_cast<std::size_t>(pm::kInCncState)) status.cnc_state = cnc_state_from_register(registers[pm::kInCncState]);
   if (registers.size() > static_cast<std::size_t>(pm::kInExecutedHigh + 1))
     status.cnc_executed_blocks = static_cast<std::uint64_t>(registers[pm::kInExecutedHigh]) << 16 |
                                  registers[pm::kInExecutedHigh + 1];

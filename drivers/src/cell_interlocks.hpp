@@ -10,7 +10,8 @@
 
 namespace lamina::drivers {
 
-// inputs: discrete inputs 0…5; registers: input registers 0…6 (pressure … alarm_code).
+// inputs: discrete inputs 0…5; registers: input registers from 0 (pressure, …, alarm_code, and
+// when given cnc_state and the executed-block count).
 void decode_cell_inputs(std::span<const std::uint8_t> inputs, std::span<const std::uint16_t> registers,
                         CellStatus& status);
 
@@ -18,5 +19,17 @@ void decode_cell_inputs(std::span<const std::uint8_t> inputs, std::span<const st
 std::optional<CellFaultReport> check_interlocks(const CellStatus& status, const CellIoSettings& settings);
 
 inline double mpa_from_01mpa(double value_01mpa) { return value_01mpa / 10.0; }
+
+// Input register cnc_state (docs/modbus-map.md): 0 idle, 1 run, 2 hold pending, 3 hold, 4 alarm.
+inline ControllerState cnc_state_from_register(std::uint16_t value) {
+  switch (value) {
+    case 0: return ControllerState::idle;
+    case 1: return ControllerState::run;
+    case 2: return ControllerState::hold_pending;
+    case 3: return ControllerState::hold;
+    case 4: return ControllerState::alarm;
+    default: return ControllerState::unknown;
+  }
+}
 
 }  // namespace lamina::drivers

@@ -31,7 +31,7 @@ LinkError interlock(std::string message) { return {LinkErrorCode::interlock, std
 }  // namespace
 
 struct CellIo::Impl {
-  enum class Kind { prepare, finish };
+  enum class Kind { prepare, finish, reset_cnc };
   struct Command {
     Kind kind;
     std::promise<Result> done;
@@ -57,7 +57,6 @@ struct CellIo::Impl {
   std::deque<Command> commands;
   std::atomic<bool> jet_off_requested{false};
   std::atomic<bool> feed_hold_requested{false};
-  std::atomic<bool> cnc_reset_requested{false};
   std::atomic<bool> stopping{false};
   std::optional<CellFaultReport> fault;
   std::function<void(const CellFaultReport&)> callback;
@@ -82,9 +81,6 @@ struct CellIo::Impl {
   void run() {
     while (true) {
       if (jet_off_requested.exchange(false)) write_jet_off("jet_off() requested");
-      if (cnc_reset_requested.exchange(false)) {
-        if (auto r = client.write_bit(pm::kCoilCncReset, true); !r) log->warn("CNC reset through the PLC: {}", r.error().message);
-      }
       if (feed_hold_requested.exchange(false)) {
         if (auto r = client.write_bit(pm::kCoilCncFeedHold, true); !r)
           log->warn("feed hold through the PLC: {}", r.error().message);
@@ -99,7 +95,7 @@ struct CellIo::Impl {
         }
       }
       if (command) {
-        command->done.set_value(command->kind == Kind::prepare ? prepare() : finish());
+        command->done.set_value(execute(command->kind));
         continue;
       }
       if (monitoring && Clock::now() >= next_heartbeat) beat();
@@ -107,8 +103,7 @@ struct CellIo::Impl {
       const auto deadline = monitoring ? std::min(next_heartbeat, next_poll) : Clock::now() + std::chrono::seconds(1);
       std::unique_lock lock(mutex);
       wake.wait_until(lock, deadline,
-                      [this] { return !commands.empty() || jet_off_requested || feed_hold_requested || cnc_reset_requested ||
-                             stopping;
+                      [this] { return !commands.empty() || jet_off_requested || feed_hold_requested || stopping;
                     });
     }
     // Best effort on the way out: the jet must not stay consented with nobody watching.
@@ -118,6 +113,25 @@ struct CellIo::Impl {
     std::lock_guard lock(mutex);
     for (auto& c : commands) c.done.set_value(std::unexpected(LinkError{LinkErrorCode::cancelled, "CellIo destroyed"}));
     commands.clear();
+  }
+
+  // Sets a flag the thread acts on. The mutex is taken so the thread cannot miss the wake-up
+  // between checking its flags and starting to wait (it would then sleep a whole period).
+  void signal(std::atomic<bool>& flag) {
+    {
+      std::lock_guard lock(mutex);
+      flag = true;
+    }
+    wake.notify_all();
+  }
+
+  Result execute(Kind kind) {
+    switch (kind) {
+      case Kind::prepare: return prepare();
+      case Kind::finish: return finish();
+      case Kind::reset_cnc: return reset_cnc();
+    }
+    return {};
   }
 
   void write_jet_off(const char* why) {
@@ -227,6 +241,31 @@ struct CellIo::Impl {
     return {};
   }
 
+  // The reset button, then the CNC's state as the PLC reads it until it is idle: its buffer
+  // and queue are gone and it takes a new program. An alarm that outlives the reset (its cause
+  // is still there) is reported with the state read.
+  Result reset_cnc() {
+    if (auto r = client.write_bit(pm::kCoilCncReset, true); !r) return r;
+    log->info("CNC reset through the PLC");
+    const auto deadline = Clock::now() + seconds(settings.cnc_reset_timeout_s);
+    // The PLC hands the press on in its next scan; a state read before that is the old one.
+    if (interrupted_sleep(std::max(0.01, settings.poll_period_s)) && stopping)
+      return std::unexpected(LinkError{LinkErrorCode::cancelled, "CNC reset: CellIo shutting down"});
+    while (true) {
+      if (auto r = read_inputs(); !r) return r;
+      const ControllerState state = snapshot().cnc_state;
+      if (state == ControllerState::idle) return {};
+      if (Clock::now() >= deadline)
+        return std::unexpected(LinkError{LinkErrorCode::timeout,
+                                         fmt::format("the CNC is not idle {} s after the PLC's reset (state {})",
+                                                     settings.cnc_reset_timeout_s, to_string(state))});
+      if (interrupted_sleep(std::max(0.01, settings.poll_period_s))) {
+        if (stopping) return std::unexpected(LinkError{LinkErrorCode::cancelled, "CNC reset: CellIo shutting down"});
+        if (jet_off_requested.exchange(false)) write_jet_off("jet_off() requested");
+      }
+    }
+  }
+
   Result finish() {
     monitoring = false;  // the heartbeat stops with it: the PLC's watchdog takes over
     Result first = {};
@@ -285,28 +324,16 @@ struct CellIo::Impl {
 CellIo::CellIo(CellIoSettings settings) : impl_(std::make_unique<Impl>(std::move(settings))) {}
 
 CellIo::~CellIo() {
-  impl_->stopping = true;
-  impl_->wake.notify_all();
+  impl_->signal(impl_->stopping);
   impl_->thread.join();
 }
 
 std::expected<void, LinkError> CellIo::prepare_cut() { return impl_->submit(Impl::Kind::prepare); }
 std::expected<void, LinkError> CellIo::finish_cut() { return impl_->submit(Impl::Kind::finish); }
 
-void CellIo::jet_off() {
-  impl_->jet_off_requested = true;
-  impl_->wake.notify_all();
-}
-
-void CellIo::reset_cnc() {
-  impl_->cnc_reset_requested = true;
-  impl_->wake.notify_all();
-}
-
-void CellIo::feed_hold() {
-  impl_->feed_hold_requested = true;
-  impl_->wake.notify_all();
-}
+void CellIo::jet_off() { impl_->signal(impl_->jet_off_requested); }
+std::expected<void, LinkError> CellIo::reset_cnc() { return impl_->submit(Impl::Kind::reset_cnc); }
+void CellIo::feed_hold() { impl_->signal(impl_->feed_hold_requested); }
 
 void CellIo::on_fault(std::function<void(const CellFaultReport&)> callback) {
   std::lock_guard lock(impl_->mutex);

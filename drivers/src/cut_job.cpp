@@ -89,9 +89,13 @@ CutReport CutJob::resume() {
     plan = report_.resume;
   }
   if (!link_.can_reset() && cell_) {
-    // The queue a held drip feed still holds must go before the program restarts.
-    cell_->reset_cnc();
-    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    // The queue a held drip feed still holds must go before the program restarts: the PLC's
+    // reset button, then the CNC reads idle (recover() below waits for the line's release).
+    if (auto reset = cell_->reset_cnc(); !reset) {
+      std::lock_guard lock(mutex_);
+      report_.reason = reset.error();
+      return report_;  // still stopped
+    }
   }
   if (auto error = link_.recover(settings_.stop_timeout_s)) {
     std::lock_guard lock(mutex_);
@@ -235,6 +239,8 @@ void CutJob::stop_safely(LinkError why) {
       still = p.last_status;
       break;
     }
+    // A drip feed reports nothing on its line: the PLC's reading of the CNC's state lamps.
+    if (cell_ && p.statuses_received == 0 && stopped_moving(cell_->status().cnc_state)) break;
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
   const LinkProgress p = link_.progress();

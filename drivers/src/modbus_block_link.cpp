@@ -243,8 +243,11 @@ ModbusBlockLink::ModbusBlockLink(ModbusBlockSettings settings)
     : impl_(std::make_unique<Impl>(std::move(settings))) {}
 
 ModbusBlockLink::~ModbusBlockLink() {
-  impl_->shutting_down = true;
-  impl_->stop_requested = true;  // a job in progress ends at its next check
+  {
+    std::lock_guard lock(impl_->mutex);  // so the thread cannot miss the wake-up
+    impl_->shutting_down = true;
+    impl_->stop_requested = true;  // a job in progress ends at its next check
+  }
   impl_->wake.notify_all();
   impl_->thread.join();
 }

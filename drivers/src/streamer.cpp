@@ -1,5 +1,6 @@
 #include "lamina/drivers/streamer.hpp"
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
@@ -60,6 +61,7 @@ struct Streamer::Impl {
   std::size_t span_size = 0, first_index = 0;
   bool error_lock_pending = false;
   std::atomic<int> resets_seen{0};    // banners while not streaming (recover() waits for one)
+  std::atomic<bool> flow_held{false};  // the protocol's flow_stopped(), readable off the io thread
   bool awaiting_banner = false;
   Clock::time_point connected_at{};
   int idle_with_lines_in_flight = 0;  // consecutive Idle reports while we wait for acks
@@ -77,10 +79,13 @@ struct Streamer::Impl {
     thread = std::thread([this] { io.run(); });
   }
   ~Impl() {
+    // Close on the io thread, then stop it outright: a tick or read handler already queued
+    // when the close ran would otherwise re-arm itself and keep run() going forever.
     asio::post(io, [this] {
       tick.cancel();
       if (transport) transport->close();
       guard.reset();
+      io.stop();
     });
     thread.join();
   }
@@ -174,6 +179,7 @@ struct Streamer::Impl {
       }
       last_heard = Clock::now();
       handle(protocol->on_received(std::string_view(reinterpret_cast<const char*>(read_buffer.data()), n)));
+      flow_held = protocol->flow_stopped();
       if (transport) read_more();
     });
   }
@@ -301,8 +307,11 @@ struct Streamer::Impl {
   std::string paced_program_bytes() {
     if (settings.pace_bytes_per_s <= 0) return protocol->take_sendable();
     const auto now = Clock::now();
-    pace_credit_bytes = std::min(settings.pace_bytes_per_s * kPacingBacklogS,
-                                 pace_credit_bytes + seconds_between(pace_last, now) * settings.pace_bytes_per_s);
+    double backlog_bytes = settings.pace_bytes_per_s * kPacingBacklogS;
+    if (const std::size_t cap = protocol->max_backlog_bytes(); cap > 0)
+      backlog_bytes = std::min(backlog_bytes, static_cast<double>(cap));
+    pace_credit_bytes =
+        std::min(backlog_bytes, pace_credit_bytes + seconds_between(pace_last, now) * settings.pace_bytes_per_s);
     pace_last = now;
     if (pace_credit_bytes < 1) return {};
     // take_sendable hands out whole lines (or a chunk); let the credit go negative by one line
@@ -327,8 +336,16 @@ struct Streamer::Impl {
     shared_progress.seconds = seconds_between(started, Clock::now());
   }
 
+  // Paced with a small backlog bound (XON/XOFF), the wire drains the bound quicker than the
+  // usual tick: wake up twice per bound so the link stays busy (at least every 0.5 ms).
+  double tick_period_s() const {
+    const std::size_t cap = protocol->max_backlog_bytes();
+    if (cap == 0 || settings.pace_bytes_per_s <= 0) return kTickS;
+    return std::clamp(static_cast<double>(cap) / settings.pace_bytes_per_s / 2, 0.0005, kTickS);
+  }
+
   void schedule_tick() {
-    tick.expires_after(std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(kTickS)));
+    tick.expires_after(std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(tick_period_s())));
     tick.async_wait([this](boost::system::error_code ec) {
       if (ec) return;
       on_tick();
@@ -431,6 +448,13 @@ std::optional<LinkError> Streamer::recover(double timeout_s) {
       std::this_thread::sleep_for(std::chrono::milliseconds(10));
     if (impl_->resets_seen.load() == before)
       return LinkError{LinkErrorCode::timeout, "no banner after the soft reset"};
+  }
+  if (reset.empty()) {
+    // A drip feed is reset from the panel or the PLC, not over its line; it then releases the
+    // line (SYN, then DC1). Streaming before that would run into the XOFF of the held buffer.
+    while (impl_->flow_held.load() && Clock::now() < deadline) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    if (impl_->flow_held.load())
+      return LinkError{LinkErrorCode::timeout, "the controller still holds the line (XOFF) after its reset"};
   }
   const auto unlock = impl_->protocol->unlock_lines();
   if (unlock.empty()) return std::nullopt;

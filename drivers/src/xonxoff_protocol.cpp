@@ -98,6 +98,7 @@ class XonXoffProtocol final : public LineProtocol {
   std::string clear_error_lock() const override { return {}; }
 
   bool flow_stopped() const override { return xoff_ && !halted_; }
+  std::size_t max_backlog_bytes() const override { return settings_.chunk_bytes; }
   std::size_t lines_sent() const override { return written_lines_; }
   std::size_t lines_accepted() const override { return written_lines_; }
   // Done when the closing `%` is out too: the controller ends the tape image there.

@@ -81,9 +81,18 @@ void Plc::take_cnc_buttons_from_coils() {
     regs_.coils[address] = 0;
     pressed = true;
   };
-  press(mm::kCoilCncFeedHold, buttons_.feed_hold);
-  press(mm::kCoilCncCycleStart, buttons_.cycle_start);
-  press(mm::kCoilCncReset, buttons_.reset);
+  CncButtons now;
+  press(mm::kCoilCncFeedHold, now.feed_hold);
+  press(mm::kCoilCncCycleStart, now.cycle_start);
+  press(mm::kCoilCncReset, now.reset);
+  if (now.reset) {
+    // The CNC side takes the presses of one scan together, reset first. A hold or cycle start
+    // pressed in an earlier write is spent by this reset, not replayed on the reset machine.
+    buttons_ = now;
+  } else {
+    buttons_.feed_hold = buttons_.feed_hold || now.feed_hold;
+    buttons_.cycle_start = buttons_.cycle_start || now.cycle_start;
+  }
 }
 
 void Plc::set_estop(bool pressed) {

@@ -199,6 +199,16 @@ void SimRuntime::move_bytes_out(double wall) {
 
 void SimRuntime::tick_plc(double now) {
   std::lock_guard lock(plc_mutex_);
+  // The CNC's panel buttons wired through the PLC (coils 4…6): the same actions as the serial
+  // line's real-time bytes, so a Modbus-fed controller can be held, resumed and reset. Taken
+  // before the snapshot, so the state the PLC publishes already shows what a press did.
+  if (const CncButtons pressed = plc_.take_cnc_buttons(); pressed.any()) {
+    if (pressed.reset) protocol_->external_reset(now);
+    if (pressed.feed_hold) machine_.feed_hold(now);
+    if (pressed.cycle_start) machine_.cycle_start(now);
+    log_.write_event("plc_button", now, {{"feed_hold", pressed.feed_hold}, {"cycle_start", pressed.cycle_start},
+                                         {"reset", pressed.reset}});
+  }
   CncSnapshot snap;
   snap.state = state_code(machine_.state());
   snap.executed_blocks = machine_.executed_blocks();
@@ -207,15 +217,6 @@ void SimRuntime::tick_plc(double now) {
   snap.jet_request = machine_.jet_commanded();
   snap.free_blocks = machine_.free_blocks();
   plc_.tick(now, snap);
-  // The CNC's panel buttons wired through the PLC (coils 4…6): the same actions as the serial
-  // line's real-time bytes, so a Modbus-fed controller can be held, resumed and reset.
-  if (const CncButtons pressed = plc_.take_cnc_buttons(); pressed.any()) {
-    if (pressed.reset) protocol_->external_reset(now);
-    if (pressed.feed_hold) machine_.feed_hold(now);
-    if (pressed.cycle_start) machine_.cycle_start(now);
-    log_.write_event("plc_button", now, {{"feed_hold", pressed.feed_hold}, {"cycle_start", pressed.cycle_start},
-                                         {"reset", pressed.reset}});
-  }
   // The e-stop chain reaches the CNC too: pressed → ALARM:10 / NAK.
   if (plc_.estop_pressed() != estop_applied_) {
     estop_applied_ = plc_.estop_pressed();

@@ -33,7 +33,7 @@ class XonXoffProtocol final : public CncProtocol {
   void on_connect(double /*now_s*/) override {
     if (machine_.alarm()) return;  // nothing to ask for until a reset clears the alarm
     out_ += kDc1;
-    xoff_ = false;
+    xoff_ = xoff_on_wire_ = false;
   }
 
   void on_byte(std::uint8_t byte, double now_s) override {
@@ -49,7 +49,9 @@ class XonXoffProtocol final : public CncProtocol {
       rx_state_ = RxState::wait_start;  // the closing `%` (still stored: it ends the last line)
     }
     // The sender needs a few characters to react to DC3; beyond the margin it is overrunning.
-    if (xoff_ && ++bytes_since_xoff_ > params_.overrun_margin_bytes) {
+    // Counted from when the DC3 went out: bytes taken in the same late wake-up as the one that
+    // crossed the high-water mark were on the wire before the sender could have seen it.
+    if (xoff_ && xoff_on_wire_ && ++bytes_since_xoff_ > params_.overrun_margin_bytes) {
       overflow(now_s);
       return;
     }
@@ -74,18 +76,24 @@ class XonXoffProtocol final : public CncProtocol {
       rx_state_ = RxState::wait_start;
       reset_line_state();
       out_ += kDc1;
-      xoff_ = false;
+      xoff_ = xoff_on_wire_ = false;
     }
     while (!stalled_ && take_line(now_s)) {
       if (check_alarm()) return;
     }
     if (xoff_ && buf_.size() < params_.low_water_bytes) {
       out_ += kDc1;
-      xoff_ = false;
+      xoff_ = xoff_on_wire_ = false;
     }
   }
 
-  std::string take_output() override { return std::exchange(out_, {}); }
+  std::string take_output() override {
+    if (xoff_ && !xoff_on_wire_) {
+      xoff_on_wire_ = true;
+      bytes_since_xoff_ = 0;
+    }
+    return std::exchange(out_, {});
+  }
   void set_stalled(bool stalled) override { stalled_ = stalled; }
 
   void external_reset(double now_s) override {
@@ -187,6 +195,7 @@ class XonXoffProtocol final : public CncProtocol {
   ProtocolCounters counters_;
   RxState rx_state_ = RxState::wait_start;
   bool xoff_ = false;                  // DC3 sent, DC1 not yet
+  bool xoff_on_wire_ = false;          // that DC3 has left (take_output): the sender can see it
   std::size_t bytes_since_xoff_ = 0;
   bool stalled_ = false;
   char last_eol_ = 0;

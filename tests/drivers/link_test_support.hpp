@@ -62,7 +62,8 @@ struct CliRun {
 
 inline CliRun run_lamina_stream(const std::string& args) {
   CliRun r;
-  const std::string command = fmt::format("'{}' stream {} --json 2>&1 < /dev/null", LAMINA_CLI, args);
+  // Under `timeout`: a CLI that hangs fails its test in minutes, not at ctest's 25-minute limit.
+  const std::string command = fmt::format("timeout -k 5 180 '{}' stream {} --json 2>&1 < /dev/null", LAMINA_CLI, args);
   FILE* pipe = ::popen(command.c_str(), "r");
   char chunk[4096];
   while (pipe && std::fgets(chunk, sizeof chunk, pipe)) r.output += chunk;

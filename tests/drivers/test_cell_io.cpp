@@ -5,6 +5,8 @@
 #include <atomic>
 #include <mutex>
 
+#include <fmt/format.h>
+
 #include "lamina/drivers/cell_io.hpp"
 #include "modbus_test_client.hpp"
 
@@ -211,6 +213,43 @@ TEST(CellIo, JetOffFromAnotherThreadClosesTheJet) {
   ASSERT_TRUE(eventually([&] { return plc.coil(map::kCoilJet) == 0; }, 1.0));
   EXPECT_LT(seconds_since(t0), 0.5 + 0.1) << "at most one response timeout";
   EXPECT_EQ(plc.coil(map::kCoilPump), 1) << "jet_off touches the jet only";
+}
+
+// A drip-fed program is running, held by the PLC's button, then reset by its other button: the
+// CNC's queue is gone and it reads idle when reset_cnc() returns.
+TEST(CellIo, ResetCncFlushesAHeldProgramAndReturnsWhenTheCncIsIdle) {
+  SimCell cell({"--personality", "xonxoff", "--time-scale", "1"});
+  PlcProbe plc(cell.sim.modbus_port());
+  auto client = sim::testing::StreamClient::open_pty(cell.dir.file("cnc"));
+  std::string program = "%\n";
+  for (int i = 0; i < 20; ++i) program += fmt::format("G1X{}F600\n", 10 * (i % 2));
+  ASSERT_TRUE(client.send(program));
+  ASSERT_TRUE(eventually([&] { return plc.in_reg(map::kInCncState) == 1; }, 3.0)) << "running";
+  CellIo io(settings_for(cell.sim.modbus_port()));
+  io.feed_hold();
+  ASSERT_TRUE(eventually([&] { return plc.in_reg(map::kInCncState) == 3; }, 3.0)) << "held";
+  EXPECT_GT(sim::testing::control_status(cell.sim.control_port())["queued_blocks"].get<int>(), 0);
+  const auto r = io.reset_cnc();
+  ASSERT_TRUE(r) << r.error().message;
+  EXPECT_EQ(plc.in_reg(map::kInCncState), 0);
+  EXPECT_EQ(io.status().cnc_state, ControllerState::idle);
+  EXPECT_EQ(sim::testing::control_status(cell.sim.control_port())["queued_blocks"], 0) << "the queue was flushed";
+}
+
+// The e-stop outlives any reset: reset_cnc() says the CNC stayed in alarm, within its timeout.
+TEST(CellIo, ResetCncWithTheEstopPressedNamesTheAlarm) {
+  SimCell cell;
+  ASSERT_EQ(sim::testing::control(cell.sim.control_port(), "estop on"), "ok");
+  PlcProbe plc(cell.sim.modbus_port());
+  ASSERT_TRUE(eventually([&] { return plc.in_reg(map::kInCncState) == 4; }, 3.0)) << "the e-stop reached the CNC";
+  auto settings = settings_for(cell.sim.modbus_port());
+  settings.cnc_reset_timeout_s = 0.5;
+  CellIo io(settings);
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto r = io.reset_cnc();
+  ASSERT_FALSE(r);
+  EXPECT_NE(r.error().message.find("alarm"), std::string::npos) << r.error().message;
+  EXPECT_LT(seconds_since(t0), 2.0);
 }
 
 }  // namespace

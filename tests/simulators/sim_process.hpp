@@ -16,6 +16,7 @@
 #include <chrono>
 #include <csignal>
 #include <cstdint>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -46,6 +47,8 @@ class TempDir {
     path_ = pattern;
   }
   ~TempDir() {
+    // LAMINA_KEEP_TEST_DIRS=1 keeps the logs of a failing run for a look afterwards.
+    if (const char* keep = std::getenv("LAMINA_KEEP_TEST_DIRS"); keep && std::string(keep) == "1") return;
     std::error_code ec;
     std::filesystem::remove_all(path_, ec);
   }

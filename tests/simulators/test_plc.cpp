@@ -417,5 +417,22 @@ TEST(Plc, CncButtonsArePushButtonsTakenOnce) {
   EXPECT_EQ(cell.r().coils[mm::kCoilCncReset], 0);
 }
 
+// Two writes in one scan, hold then reset: the reset machine must not come back held (a held
+// drip feed would then hold its next program's bytes for ever).
+TEST(Plc, ResetSpendsAHoldPressedBeforeItInTheSameScan) {
+  Cell cell;
+  cell.coil(mm::kCoilCncFeedHold, true);
+  cell.coil(mm::kCoilCncReset, true);
+  auto pressed = cell.plc.take_cnc_buttons();
+  EXPECT_TRUE(pressed.reset);
+  EXPECT_FALSE(pressed.feed_hold);
+  // The other order holds the machine after its reset.
+  cell.coil(mm::kCoilCncReset, true);
+  cell.coil(mm::kCoilCncFeedHold, true);
+  pressed = cell.plc.take_cnc_buttons();
+  EXPECT_TRUE(pressed.reset);
+  EXPECT_TRUE(pressed.feed_hold);
+}
+
 }  // namespace
 }  // namespace lamina::sim

@@ -12,6 +12,7 @@
 #include <optional>
 #include <string>
 
+#include "lamina/drivers/controller_status.hpp"
 #include "lamina/drivers/link_error.hpp"
 
 namespace lamina::drivers {
@@ -28,6 +29,7 @@ struct CellIoSettings {
   double pump_ready_timeout_s = 10;      // pump on → pump_ready
   double min_pressure_fraction = 0.9;    // below this × set point while cutting: pressure fault
   int max_reconnects = 3;                // per fault, then the cell is declared lost
+  double cnc_reset_timeout_s = 5;        // the PLC's reset button → the CNC reads idle
 };
 
 enum class CellFault {
@@ -53,6 +55,7 @@ struct CellStatus {
   // The CNC as the PLC sees it: blocks finished since power-on (comments included, one per
   // program line) — how far a controller without a status report of its own has got.
   std::optional<std::uint64_t> cnc_executed_blocks;
+  ControllerState cnc_state = ControllerState::unknown;  // the CNC's state lamps as the PLC wires them
 };
 
 class CellIo {
@@ -75,7 +78,9 @@ class CellIo {
   // controllers whose line has no real-time hold (a drip-fed Fanuc). Right after jet_off().
   void feed_hold();
   // The PLC's reset button (coil cnc_reset): flushes a controller that has no reset on its line.
-  void reset_cnc();
+  // Blocking: returns once the PLC reads the CNC idle again, or an error naming the state it
+  // stayed in (an alarm whose cause is still there) after cnc_reset_timeout_s.
+  std::expected<void, LinkError> reset_cnc();
   // After the cut (or a stop): jet off, abrasive off, pump to idle (pump_enable = 0). Blocking.
   std::expected<void, LinkError> finish_cut();
   // While a cut is prepared, the first fault seen (sticky until the next prepare_cut); the

@@ -86,6 +86,10 @@ class LineProtocol {
 
   // True while the controller has told us to stop sending (XON/XOFF's DC3).
   virtual bool flow_stopped() const { return false; }
+  // The most program bytes the sender may have written ahead of the wire (0: no bound but
+  // the pacing's). Under XON/XOFF that backlog is what still arrives after a DC3, so it must
+  // fit the controller's tolerance (a Fanuc takes about 10 characters after DC3).
+  virtual std::size_t max_backlog_bytes() const { return 0; }
 
   virtual std::size_t lines_sent() const = 0;      // of the loaded span
   virtual std::size_t lines_accepted() const = 0;  // acknowledged (or, for XON/XOFF, written)
