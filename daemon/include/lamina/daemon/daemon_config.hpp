@@ -1,0 +1,64 @@
+#pragma once
+// laminad's configuration: TOML (/etc/lamina/lamina.toml; config/lamina.toml holds the defaults,
+// config/demo.toml points at the simulator). Validated at start: a wrong type, a value out of
+// range or an unknown key is an error naming the file, the key and (when known) the line.
+#include <expected>
+#include <filesystem>
+#include <optional>
+#include <string>
+
+namespace lamina::daemon {
+
+struct ServerConfig {
+  std::string socket_path = "/run/lamina/lamina.sock";
+  unsigned socket_mode = 0660;
+  std::string socket_group = "lamina";     // empty: leave the group as created
+  std::optional<std::string> tcp_host;     // [server] tcp = "127.0.0.1:7400"; unset: no TCP
+  int tcp_port = 0;
+  std::string token;                       // required when TCP is on (or token_file)
+  std::size_t max_request_bytes = 1 << 20;
+};
+
+struct MachineLinkConfig {
+  std::string protocol = "grbl";           // grbl | send-response | xonxoff | modbus
+  std::string port;                        // serial device or USB serial number
+  std::string tcp;                         // HOST:PORT of a networked controller
+  int baud = 115200;
+  std::size_t rx_buffer = 0;               // 0: as the controller reports
+  double status_hz = 5;
+};
+
+struct CellConfig {
+  bool enabled = true;                     // a PLC minds pump and interlocks
+  std::string modbus = "127.0.0.1:502";    // HOST:PORT
+  double heartbeat_period_s = 0.2;
+  double pump_ready_timeout_s = 10;
+  double pressure_setpoint_mpa = 380;
+  double abrasive_g_per_min = 350;
+};
+
+struct PlannerConfig {
+  std::string lamina_path;                 // empty: `lamina` beside laminad
+  int workers = 1;                         // planning jobs at once
+  std::string machine_file;                // --machine for lamina plan (empty: its default)
+  std::string materials_file;
+  double timeout_s = 3600;
+};
+
+struct DaemonConfig {
+  std::filesystem::path state_dir = "/var/lib/lamina";
+  ServerConfig server;
+  MachineLinkConfig link;
+  CellConfig cell;
+  PlannerConfig planner;
+  std::string source;                      // the file read, for messages
+};
+
+struct ConfigError {
+  std::string message;  // "<file>: [section] key: what is wrong"
+};
+
+std::expected<DaemonConfig, ConfigError> load_daemon_config(const std::filesystem::path& file);
+std::expected<DaemonConfig, ConfigError> parse_daemon_config(const std::string& toml_text, const std::string& source_name);
+
+}  // namespace lamina::daemon

@@ -1,0 +1,94 @@
+#pragma once
+// JSON-RPC 2.0, one JSON object per line, on a Unix socket and (when configured) TCP. Runs on
+// the caller's io_context (one thread). Each connection reads lines up to max_request_bytes
+// (longer: -32600 and the connection is closed after the reply); a client that does not read
+// its replies is dropped when its queue passes max_queued_bytes, so it never delays the others.
+// TCP requests must carry params.token equal to the configured token (-32001 otherwise).
+#include <cstdint>
+#include <expected>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include <boost/asio/io_context.hpp>
+#include <nlohmann/json.hpp>
+
+namespace lamina::daemon {
+
+// Standard JSON-RPC codes and ours (docs/api.md).
+namespace rpc_code {
+inline constexpr int parse_error = -32700;
+inline constexpr int invalid_request = -32600;
+inline constexpr int method_not_found = -32601;
+inline constexpr int invalid_params = -32602;
+inline constexpr int internal_error = -32603;
+inline constexpr int unauthorized = -32001;     // TCP without the right token
+inline constexpr int job_not_found = -32010;
+inline constexpr int invalid_state = -32011;    // e.g. confirm_sheet while planning
+inline constexpr int machine_busy = -32012;
+inline constexpr int machine_fault = -32013;
+inline constexpr int storage_error = -32014;
+inline constexpr int shutting_down = -32015;
+}  // namespace rpc_code
+
+struct RpcError {
+  int code = rpc_code::internal_error;
+  std::string message;
+  nlohmann::json data;  // null when absent
+};
+using RpcResult = std::expected<nlohmann::json, RpcError>;
+
+struct RpcRequest {
+  nlohmann::json id;       // null for a notification (no reply is sent)
+  bool is_notification = false;
+  std::string method;
+  nlohmann::json params;   // object or array; an absent params is an empty object
+};
+
+struct ClientContext {
+  std::uint64_t id = 0;
+  bool via_tcp = false;
+  bool subscribed = false;  // set by a handler (server.subscribe): receives broadcast()s
+};
+
+struct RpcServerSettings {
+  std::string unix_path;                 // empty: no Unix socket (or adopted from systemd)
+  unsigned unix_mode = 0660;
+  std::string unix_group;                // chgrp when set (e.g. "lamina")
+  std::optional<std::string> tcp_host;   // unset: no TCP
+  int tcp_port = 0;                      // 0: any free port (see tcp_port())
+  std::string token;                     // required for TCP
+  std::size_t max_request_bytes = 1 << 20;
+  std::size_t max_queued_bytes = 8 << 20;
+  std::size_t max_clients = 128;
+};
+
+class RpcServer {
+ public:
+  // Handlers run on the io thread and must return quickly (no planning, no blocking I/O).
+  using Handler = std::function<RpcResult(const RpcRequest&, ClientContext&)>;
+
+  RpcServer(boost::asio::io_context& io, RpcServerSettings settings, Handler handler);
+  ~RpcServer();
+  RpcServer(const RpcServer&) = delete;
+  RpcServer& operator=(const RpcServer&) = delete;
+
+  // Binds and listens (removing a stale socket file first). Errors name the path/port.
+  std::expected<void, std::string> listen();
+  // A listening Unix socket handed over by systemd (sd_listen_fds), instead of unix_path.
+  std::expected<void, std::string> adopt_unix_listener(int fd);
+  int tcp_port() const;  // the bound port (after listen)
+
+  // Thread-safe: a notification {"jsonrpc":"2.0","method":…,"params":…} to subscribed clients.
+  void broadcast(const std::string& method, const nlohmann::json& params);
+  // Stop accepting; close every connection. Thread-safe.
+  void stop();
+  std::size_t client_count() const;
+
+ private:
+  struct Impl;
+  std::shared_ptr<Impl> impl_;
+};
+
+}  // namespace lamina::daemon
