@@ -9,5 +9,6 @@ void add_slice_command(CLI::App& app, int& exit_code);
 void add_plan_command(CLI::App& app, int& exit_code);
 void add_ports_command(CLI::App& app, int& exit_code);
 void add_stream_command(CLI::App& app, int& exit_code);
+void add_client_commands(CLI::App& app, int& exit_code);  // laminad: submit, jobs, status…
 
 }  // namespace lamina::cli

@@ -1,2 +1,197 @@
-// laminad: placeholder until the job manager lands (issue 7 in progress).
-int main() { return 0; }
+// laminad: the cell daemon. Takes jobs over JSON-RPC (docs/api.md), plans them with `lamina plan`
+// on worker threads, and cuts them through the machine link while it minds the cell's PLC.
+// One io_context thread serves the sockets; SIGTERM stops it cleanly (the machine held, the
+// cell made safe, the job interrupted and saved). systemd: Type=notify, watchdog, socket activation.
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <thread>
+
+#include <CLI/CLI.hpp>
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/post.hpp>
+#include <boost/asio/signal_set.hpp>
+#include <boost/asio/steady_timer.hpp>
+#include <fmt/format.h>
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
+
+#include "api_methods.hpp"
+#include "job_manager.hpp"
+#include "lamina/daemon/daemon_config.hpp"
+#include "lamina/daemon/job_store.hpp"
+#include "lamina/daemon/rpc_server.hpp"
+#include "lamina/daemon/systemd_integration.hpp"
+#include "machine_session.hpp"
+
+namespace fs = std::filesystem;
+using namespace lamina::daemon;
+
+namespace {
+
+constexpr const char* kVersion = "0.7.0";
+
+// `lamina` for planning: configured, else beside laminad (build tree), else ../bin (installed).
+fs::path find_lamina(const std::string& configured) {
+  if (!configured.empty()) return configured;
+  std::error_code ec;
+  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
+  for (const fs::path& candidate : {self.parent_path() / "lamina", self.parent_path().parent_path() / "bin" / "lamina"})
+    if (!ec && ::access(candidate.c_str(), X_OK) == 0) return candidate;
+  return "/usr/bin/lamina";
+}
+
+void setup_logging() {
+  // Under systemd the journal stamps each line; elsewhere the time helps.
+  const bool journal = std::getenv("JOURNAL_STREAM") != nullptr;
+  spdlog::set_pattern(journal ? "[%n] %l: %v" : "%Y-%m-%d %H:%M:%S.%e [%n] %l: %v");
+  auto main_logger = spdlog::stderr_color_mt("laminad");
+  spdlog::set_default_logger(main_logger);
+  for (const char* name : {"jobs", "cut", "rpc", "store"})
+    if (!spdlog::get(name)) spdlog::register_logger(main_logger->clone(name));
+}
+
+template <typename F>
+void every(boost::asio::steady_timer& timer, std::chrono::milliseconds period, F f) {
+  timer.expires_after(period);
+  timer.async_wait([&timer, period, f](const boost::system::error_code& ec) {
+    if (ec) return;
+    f();
+    every(timer, period, f);
+  });
+}
+
+int run(const fs::path& config_path, bool check_only) {
+  auto config = load_daemon_config(config_path);
+  if (!config) {
+    spdlog::error("{}", config.error().message);
+    return 2;
+  }
+  if (check_only) {
+    fmt::print("{}: ok\n", config_path.string());
+    return 0;
+  }
+  config->planner.lamina_path = find_lamina(config->planner.lamina_path).string();
+
+  std::error_code ec;
+  fs::create_directories(config->state_dir / "jobs", ec);
+  if (ec) {
+    spdlog::error("state directory {}: {}", config->state_dir.string(), ec.message());
+    return 1;
+  }
+  auto store = JobStore::open(config->state_dir / "lamina.db");
+  if (!store) {
+    spdlog::error("{}", store.error().message);
+    return 1;
+  }
+  if (auto changed = (*store)->recover_after_restart(); !changed) {
+    spdlog::error("{}", changed.error().message);
+    return 1;
+  } else if (!changed->empty()) {
+    spdlog::warn("{} job(s) were cut short by the last stop: interrupted or planned again", changed->size());
+  }
+
+  std::unique_ptr<MachineSession> machine;
+  try {
+    machine = std::make_unique<MachineSession>(*config);
+  } catch (const std::exception& e) {
+    spdlog::error("{}: {}", config->source, e.what());
+    return 2;
+  }
+
+  boost::asio::io_context io;
+  RpcServerSettings rs;
+  rs.unix_path = config->server.socket_path;
+  rs.unix_mode = config->server.socket_mode;
+  rs.unix_group = config->server.socket_group;
+  rs.tcp_host = config->server.tcp_host;
+  rs.tcp_port = config->server.tcp_port;
+  rs.token = config->server.token;
+  rs.max_request_bytes = config->server.max_request_bytes;
+
+  // Socket activation: laminad.socket hands over the Unix listener; TCP (if any) is ours to open.
+  std::vector<int> activated;
+  for (int fd : systemd::listen_fds())
+    if (systemd::is_unix_stream_listener(fd)) activated.push_back(fd);
+  const bool adopted = !activated.empty();
+  if (adopted) rs.unix_path.clear();
+
+  RpcServer* server_ptr = nullptr;
+  JobManager jobs(*config, **store, *machine, [&server_ptr](const std::string& method, const nlohmann::json& params) {
+    if (server_ptr) server_ptr->broadcast(method, params);
+  });
+  RpcServer server(io, rs, make_api_handler(jobs, ServerInfo{kVersion, machine->describe(), config->state_dir.string()}));
+  server_ptr = &server;
+  for (int fd : activated)
+    if (auto r = server.adopt_unix_listener(fd); !r) {
+      spdlog::error("socket activation: {}", r.error());
+      return 1;
+    }
+  if (!adopted || rs.tcp_host) {
+    if (auto r = server.listen(); !r) {
+      spdlog::error("{}", r.error());
+      return 1;
+    }
+  }
+  if (auto r = jobs.start(); !r) {
+    spdlog::error("{}", r.error().message);
+    return 1;
+  }
+  spdlog::info("laminad {} ready: socket {}{}, {}, state in {}", kVersion,
+               adopted ? "(from systemd)" : config->server.socket_path,
+               rs.tcp_host ? fmt::format(", tcp {}:{}", *rs.tcp_host, server.tcp_port()) : std::string(),
+               machine->describe(), config->state_dir.string());
+  systemd::notify_ready(jobs.status_line());
+
+  boost::asio::steady_timer status_timer(io), watchdog_timer(io), notify_timer(io);
+  every(status_timer, std::chrono::milliseconds(500),
+        [&] { server.broadcast("notify_machine_status", jobs.machine_status()); });
+  every(notify_timer, std::chrono::milliseconds(2000), [&] { systemd::notify_status(jobs.status_line()); });
+  if (const auto period = systemd::watchdog_period()) {
+    const auto half = std::chrono::duration_cast<std::chrono::milliseconds>(*period / 2);
+    every(watchdog_timer, std::max(half, std::chrono::milliseconds(100)), [] { systemd::notify_watchdog(); });
+  }
+
+  std::thread stopper;  // winds the jobs down off the io thread, which keeps pinging the watchdog
+  boost::asio::signal_set signals(io, SIGTERM, SIGINT);
+  signals.async_wait([&](const boost::system::error_code& ec, int signal) {
+    if (ec) return;
+    spdlog::info("{}: stopping (machine held, cell made safe, jobs saved)", signal == SIGTERM ? "SIGTERM" : "SIGINT");
+    systemd::notify_stopping("stopping");
+    server.stop();
+    status_timer.cancel();
+    notify_timer.cancel();
+    stopper = std::thread([&] {
+      jobs.shutdown("the daemon was stopped (SIGTERM)");
+      boost::asio::post(io, [&] {
+        watchdog_timer.cancel();
+        io.stop();
+      });
+    });
+  });
+  io.run();
+  if (stopper.joinable()) stopper.join();
+  jobs.shutdown("the daemon was stopped");
+  spdlog::info("stopped");
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"laminad: the Lamina cell daemon (JSON-RPC on a Unix socket; see docs/api.md)"};
+  std::string config_path = "/etc/lamina/lamina.toml";
+  bool check = false;
+  app.add_option("--config", config_path, "configuration file (TOML)");
+  app.add_flag("--check-config", check, "validate the configuration and exit");
+  CLI11_PARSE(app, argc, argv);
+  setup_logging();
+  try {
+    return run(config_path, check);
+  } catch (const std::exception& e) {  // start-up failures only: the running daemon reports errors as data
+    spdlog::critical("{}", e.what());
+    return 1;
+  }
+}

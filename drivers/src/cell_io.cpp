@@ -31,7 +31,7 @@ LinkError interlock(std::string message) { return {LinkErrorCode::interlock, std
 }  // namespace
 
 struct CellIo::Impl {
-  enum class Kind { prepare, finish, reset_cnc };
+  enum class Kind { prepare, finish, reset_cnc, refresh };
   struct Command {
     Kind kind;
     std::promise<Result> done;
@@ -57,6 +57,7 @@ struct CellIo::Impl {
   std::deque<Command> commands;
   std::atomic<bool> jet_off_requested{false};
   std::atomic<bool> feed_hold_requested{false};
+  std::atomic<bool> cycle_start_requested{false};
   std::atomic<bool> stopping{false};
   std::optional<CellFaultReport> fault;
   std::function<void(const CellFaultReport&)> callback;
@@ -85,6 +86,10 @@ struct CellIo::Impl {
         if (auto r = client.write_bit(pm::kCoilCncFeedHold, true); !r)
           log->warn("feed hold through the PLC: {}", r.error().message);
       }
+      if (cycle_start_requested.exchange(false)) {
+        if (auto r = client.write_bit(pm::kCoilCncCycleStart, true); !r)
+          log->warn("cycle start through the PLC: {}", r.error().message);
+      }
       if (stopping) break;
       std::optional<Command> command;
       {
@@ -103,7 +108,9 @@ struct CellIo::Impl {
       const auto deadline = monitoring ? std::min(next_heartbeat, next_poll) : Clock::now() + std::chrono::seconds(1);
       std::unique_lock lock(mutex);
       wake.wait_until(lock, deadline,
-                      [this] { return !commands.empty() || jet_off_requested || feed_hold_requested || stopping;
+                      [this] {
+                        return !commands.empty() || jet_off_requested || feed_hold_requested || cycle_start_requested ||
+                               stopping;
                     });
     }
     // Best effort on the way out: the jet must not stay consented with nobody watching.
@@ -130,6 +137,7 @@ struct CellIo::Impl {
       case Kind::prepare: return prepare();
       case Kind::finish: return finish();
       case Kind::reset_cnc: return reset_cnc();
+      case Kind::refresh: return read_inputs();
     }
     return {};
   }
@@ -334,6 +342,8 @@ std::expected<void, LinkError> CellIo::finish_cut() { return impl_->submit(Impl:
 void CellIo::jet_off() { impl_->signal(impl_->jet_off_requested); }
 std::expected<void, LinkError> CellIo::reset_cnc() { return impl_->submit(Impl::Kind::reset_cnc); }
 void CellIo::feed_hold() { impl_->signal(impl_->feed_hold_requested); }
+void CellIo::cycle_start() { impl_->signal(impl_->cycle_start_requested); }
+std::expected<void, LinkError> CellIo::refresh() { return impl_->submit(Impl::Kind::refresh); }
 
 void CellIo::on_fault(std::function<void(const CellFaultReport&)> callback) {
   std::lock_guard lock(impl_->mutex);

@@ -61,16 +61,20 @@ void CutJob::abort(std::string why) {
   link_.stop(LinkError{LinkErrorCode::cancelled, std::move(why)});
 }
 
+std::function<void(const CellFaultReport&)> CutJob::fault_handler() {
+  return [this](const CellFaultReport& fault) {
+    // The PLC already dropped the jet; hold the motion and stop the stream.
+    cell_->jet_off();
+    cell_->feed_hold();
+    link_.request(RealtimeCommand::feed_hold);
+    link_.stop(LinkError{LinkErrorCode::interlock, fault.message});
+  };
+}
+
 CutReport CutJob::run() {
   if (cell_) {
     set_state(CutState::preparing);
-    cell_->on_fault([this](const CellFaultReport& fault) {
-      // The PLC already dropped the jet; hold the motion and stop the stream.
-      cell_->jet_off();
-      cell_->feed_hold();
-      link_.request(RealtimeCommand::feed_hold);
-      link_.stop(LinkError{LinkErrorCode::interlock, fault.message});
-    });
+    cell_->on_fault(fault_handler());
     if (auto ready = cell_->prepare_cut(); !ready) {
       std::lock_guard lock(mutex_);
       report_.state = CutState::failed;
@@ -79,6 +83,23 @@ CutReport CutJob::run() {
     }
   }
   return stream_from(0, {});
+}
+
+CutReport CutJob::resume_from(std::size_t first_unfinished_line) {
+  if (cell_) cell_->on_fault(fault_handler());
+  {
+    std::lock_guard lock(mutex_);
+    report_.first_unfinished_line = std::min(first_unfinished_line, program_.size());
+    auto plan = plan_resume(program_, report_.first_unfinished_line, settings_.safe_z_mm);
+    if (!plan) {
+      report_.state = CutState::failed;
+      report_.reason = plan.error();
+      return report_;
+    }
+    report_.resume = *plan;
+    report_.state = CutState::stopped;
+  }
+  return resume();
 }
 
 CutReport CutJob::resume() {
@@ -135,6 +156,12 @@ CutReport CutJob::stream_from(std::size_t from, std::vector<std::string> preambl
   // The machine stands still here (fresh, or recovered): its count is this attempt's base.
   executed_base_ = executed_blocks(true);
   preamble_lines_ = preamble.size();
+  {
+    std::lock_guard lock(mutex_);
+    report_.executed_base = executed_base_;
+    report_.attempt_first_line = from;
+    report_.attempt_preamble_lines = preamble_lines_;
+  }
   if (!preamble.empty()) {
     link_.start(LineSpan{std::move(preamble), 0}, {});
     const auto outcome = link_.wait(settings_.stop_timeout_s * 4);

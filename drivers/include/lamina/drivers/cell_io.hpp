@@ -77,6 +77,11 @@ class CellIo {
   // The PLC's feed-hold button (coil cnc_feed_hold): the motion's independent stop for
   // controllers whose line has no real-time hold (a drip-fed Fanuc). Right after jet_off().
   void feed_hold();
+  // The PLC's cycle-start button (coil cnc_cycle_start): continues a held drip feed.
+  void cycle_start();
+  // Blocking: read the PLC's inputs now (status() is otherwise refreshed only while a cut is
+  // prepared and monitored) — e.g. the CNC's executed-block count after a restart.
+  std::expected<void, LinkError> refresh();
   // The PLC's reset button (coil cnc_reset): flushes a controller that has no reset on its line.
   // Blocking: returns once the PLC reads the CNC idle again, or an error naming the state it
   // stayed in (an alarm whose cause is still there) after cnc_reset_timeout_s.

@@ -42,6 +42,11 @@ struct CutReport {
   std::optional<ControllerStatus> last_status;
   double seconds = 0;
   std::size_t bytes_sent = 0;
+  // The attempt streaming now (or last): what a supervisor persists so that after a crash the
+  // CNC's executed-block count still places the stop. attempt_first_line is 0-based.
+  std::optional<std::uint64_t> executed_base;  // the count when the attempt started
+  std::size_t attempt_first_line = 0;
+  std::size_t attempt_preamble_lines = 0;
 };
 
 class CutJob {
@@ -54,6 +59,10 @@ class CutJob {
   CutReport run();
   // Blocking: the operator's resume of a stopped job, from report().resume.
   CutReport resume();
+  // Blocking: resume a cut another process (or run) left off — after a crash the supervisor
+  // knows where from its records, not this object: from the start of the contour holding
+  // first_unfinished_line (0-based). The cell is brought up first, as in run().
+  CutReport resume_from(std::size_t first_unfinished_line);
 
   // From any thread (keyboard, daemon): feed hold / cycle start without stopping the job, and
   // abort (stops the job like a fault, reason cancelled).
@@ -69,6 +78,7 @@ class CutJob {
   // Blocks the CNC has finished, from the link's status or the PLC's (nullopt: neither says).
   std::optional<std::uint64_t> executed_blocks(bool fresh);
   void stop_safely(LinkError why);
+  std::function<void(const CellFaultReport&)> fault_handler();
   void set_state(CutState state);
 
   MachineLink& link_;

@@ -1,0 +1,271 @@
+// The daemon's client commands: lamina submit | jobs | job | status | hold | resume | abort |
+// confirm | cancel. They speak JSON-RPC to laminad (docs/api.md) over its Unix socket, or TCP
+// with a token; --json prints the daemon's answer as it came.
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <memory>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "commands.hpp"
+#include "lamina/daemon/rpc_client.hpp"
+
+namespace lamina::cli {
+namespace {
+
+using Json = nlohmann::json;
+using daemon::RpcClient;
+
+struct ClientOptions {
+  std::string socket;
+  std::string tcp, token;
+  bool json = false;
+};
+
+std::string default_socket() {
+  if (const char* s = std::getenv("LAMINA_SOCKET")) return s;
+  return "/run/lamina/lamina.sock";
+}
+
+std::expected<RpcClient, std::string> connect(const ClientOptions& o) {
+  if (!o.tcp.empty()) {
+    const auto colon = o.tcp.rfind(':');
+    if (colon == std::string::npos) return std::unexpected(fmt::format("--tcp '{}': expected HOST:PORT", o.tcp));
+    int port = 0;
+    try {
+      port = std::stoi(o.tcp.substr(colon + 1));
+    } catch (const std::exception&) {
+      return std::unexpected(fmt::format("--tcp '{}': the port is not a number", o.tcp));
+    }
+    std::string token = o.token;
+    if (token.empty())
+      if (const char* t = std::getenv("LAMINA_TOKEN")) token = t;
+    return RpcClient::connect_tcp(o.tcp.substr(0, colon), port, token);
+  }
+  return RpcClient::connect_unix(o.socket.empty() ? default_socket() : o.socket);
+}
+
+// One call; prints the error (code and message) and returns nullopt when it failed.
+std::optional<Json> call(const ClientOptions& o, const std::string& method, Json params = Json::object()) {
+  auto client = connect(o);
+  if (!client) {
+    fmt::print(stderr, "lamina: cannot reach laminad: {}\n", client.error());
+    return std::nullopt;
+  }
+  auto r = client->call(method, std::move(params));
+  if (!r) {
+    fmt::print(stderr, "lamina: {} failed: {} (code {})\n", method, r.error().message, r.error().code);
+    return std::nullopt;
+  }
+  return *r;
+}
+
+std::string position_text(const Json& p) {
+  if (!p.is_object()) return "-";
+  return fmt::format("X{:.3f} Y{:.3f} Z{:.3f} A{:.2f} C{:.2f}", p.value("x_mm", 0.0), p.value("y_mm", 0.0),
+                     p.value("z_mm", 0.0), p.value("a_deg", 0.0), p.value("c_deg", 0.0));
+}
+
+void print_job(const Json& j) {
+  fmt::print("{}  {}  {}  sheet {}/{}{}\n", j.value("id", "?"), j.value("state", "?"), j.value("name", ""),
+             j.value("current_sheet", 0), j.contains("sheets") && j["sheets"].is_array() ? j["sheets"].size() : 0,
+             j.value("error", "").empty() ? "" : "  (" + j.value("error", "") + ")");
+}
+
+std::string bar(double fraction) {
+  constexpr int kWidth = 30;
+  const int filled = static_cast<int>(std::clamp(fraction, 0.0, 1.0) * kWidth);
+  return fmt::format("[{}{}]", std::string(static_cast<std::size_t>(filled), '#'),
+                     std::string(static_cast<std::size_t>(kWidth - filled), '-'));
+}
+
+// Follows a job through planning and cutting until it needs the operator or ends.
+int follow(const ClientOptions& o, const std::string& id) {
+  auto client = connect(o);
+  if (!client) return 1;
+  if (!client->call("server.subscribe")) return 1;
+  auto job = client->call("job.get", {{"job", id}});
+  if (!job) return 1;
+  Json j = *job;
+  const bool tty = ::isatty(STDERR_FILENO);
+  while (true) {
+    const std::string state = j.value("state", "");
+    if (j.value("id", "") == id) {
+      std::string line = fmt::format("{} {}", id, state);
+      if (j.contains("progress")) {
+        const Json& p = j["progress"];
+        const double f = p.value("lines", 0) ? p.value("lines_accepted", 0) / double(p.value("lines", 1)) : 0;
+        line += fmt::format(" sheet {} {} {:5.1f} %", p.value("sheet", 0), bar(f), 100 * f);
+      }
+      if (tty) fmt::print(stderr, "\r{:<100}", line);
+      if (state == "completed" || state == "failed" || state == "cancelled" || state == "interrupted" ||
+          state == "waiting_sheet" || state == "paused") {
+        if (tty) fmt::print(stderr, "\n");
+        print_job(j);
+        if (state == "waiting_sheet")
+          fmt::print("load sheet {} on the table, then: lamina confirm {} {}\n", j.value("current_sheet", 0), id,
+                     j.value("current_sheet", 0));
+        if (state == "completed" && j.contains("summary")) fmt::print("{}\n", j["summary"].dump(2));
+        return state == "failed" || state == "cancelled" ? 1 : 0;
+      }
+    }
+    auto n = client->next_notification(3600);
+    if (!n) return 1;
+    if (n->value("method", "") == "notify_job_progress") j = (*n)["params"];
+  }
+}
+
+void add_common(CLI::App* cmd, ClientOptions& o) {
+  cmd->add_option("--socket", o.socket, "laminad's Unix socket (default $LAMINA_SOCKET or /run/lamina/lamina.sock)");
+  cmd->add_option("--tcp", o.tcp, "laminad over TCP, HOST:PORT (token from --token or $LAMINA_TOKEN)");
+  cmd->add_option("--token", o.token, "the daemon's TCP token");
+  cmd->add_flag("--json", o.json, "print the daemon's answer as JSON");
+}
+
+}  // namespace
+
+void add_client_commands(CLI::App& app, int& exit_code) {
+  auto o = std::make_shared<ClientOptions>();
+  auto print_or = [o](const Json& result, const std::function<void(const Json&)>& human) {
+    if (o->json) fmt::print("{}\n", result.dump(2));
+    else human(result);
+  };
+
+  // submit
+  {
+    struct Submit {
+      std::string model, name;
+      std::vector<std::string> set;
+      bool follow = false;
+    };
+    auto s = std::make_shared<Submit>();
+    auto* cmd = app.add_subcommand("submit", "submit a model to laminad: it plans it, then cuts it sheet by sheet");
+    cmd->add_option("model", s->model, "mesh file on the cell PC")->required();
+    cmd->add_option("--name", s->name, "the job's name (default: the file name)");
+    cmd->add_option("--set", s->set, "plan setting KEY=VALUE (docs/api.md), e.g. strategy=curved microjoints=2");
+    cmd->add_flag("--follow", s->follow, "show planning and cutting progress until the job needs you");
+    add_common(cmd, *o);
+    cmd->callback([o, s, &exit_code, print_or] {
+      Json settings = Json::object();
+      for (const std::string& kv : s->set) {
+        const auto eq = kv.find('=');
+        if (eq == std::string::npos) {
+          fmt::print(stderr, "lamina submit: --set {}: expected KEY=VALUE\n", kv);
+          exit_code = 2;
+          return;
+        }
+        const std::string key = kv.substr(0, eq), value = kv.substr(eq + 1);
+        // Numbers and booleans as JSON; anything else as text.
+        try {
+          settings[key] = Json::parse(value);
+          if (settings[key].is_string() || settings[key].is_object() || settings[key].is_array()) settings[key] = value;
+        } catch (const std::exception&) {
+          settings[key] = value;
+        }
+      }
+      std::error_code ec;
+      const std::string model = std::filesystem::absolute(s->model, ec).string();
+      Json params{{"model", model}, {"settings", settings}};
+      if (!s->name.empty()) params["name"] = s->name;
+      auto r = call(*o, "job.submit", params);
+      if (!r) {
+        exit_code = 1;
+        return;
+      }
+      print_or(*r, [](const Json& j) { fmt::print("submitted {}\n", j.value("id", "?")); });
+      if (s->follow) exit_code = follow(*o, r->value("id", ""));
+    });
+  }
+  // jobs
+  {
+    auto* cmd = app.add_subcommand("jobs", "list laminad's jobs");
+    add_common(cmd, *o);
+    cmd->callback([o, &exit_code, print_or] {
+      auto r = call(*o, "job.list");
+      if (!r) {
+        exit_code = 1;
+        return;
+      }
+      print_or(*r, [](const Json& list) {
+        for (const Json& j : list)
+          fmt::print("{}  {:<13} {}  sheet {}/{}{}\n", j.value("id", "?"), j.value("state", "?"), j.value("name", ""),
+                     j.value("current_sheet", 0), j.value("sheets", 0),
+                     j.value("error", "").empty() ? "" : "  (" + j.value("error", "") + ")");
+      });
+    });
+  }
+  // job / cancel / resume / confirm: one job each
+  for (const auto& [name, method, help] : std::vector<std::tuple<std::string, std::string, std::string>>{
+           {"job", "job.get", "show one job"},
+           {"cancel", "job.cancel", "cancel a job (a cut in progress stops safely first)"},
+           {"resume", "job.resume", "resume a paused or interrupted job (from the start of the contour it was cutting)"}}) {
+    auto id = std::make_shared<std::string>();
+    auto* cmd = app.add_subcommand(name, help);
+    cmd->add_option("job", *id, "job id")->required();
+    add_common(cmd, *o);
+    cmd->callback([o, id, method, &exit_code, print_or] {
+      auto r = call(*o, method, {{"job", *id}});
+      if (!r) {
+        exit_code = 1;
+        return;
+      }
+      print_or(*r, [](const Json& j) { print_job(j); });
+    });
+  }
+  {
+    auto id = std::make_shared<std::string>();
+    auto sheet = std::make_shared<int>(0);
+    auto* cmd = app.add_subcommand("confirm", "the sheet is on the table: cut it");
+    cmd->add_option("job", *id, "job id")->required();
+    cmd->add_option("sheet", *sheet, "sheet number")->required();
+    add_common(cmd, *o);
+    cmd->callback([o, id, sheet, &exit_code, print_or] {
+      auto r = call(*o, "job.confirm_sheet", {{"job", *id}, {"sheet", *sheet}});
+      if (!r) {
+        exit_code = 1;
+        return;
+      }
+      print_or(*r, [](const Json& j) { print_job(j); });
+    });
+  }
+  // status / hold / abort / machine resume
+  {
+    auto* cmd = app.add_subcommand("status", "the machine in one line: state, position, feed, line");
+    add_common(cmd, *o);
+    cmd->callback([o, &exit_code, print_or] {
+      auto r = call(*o, "machine.status");
+      if (!r) {
+        exit_code = 1;
+        return;
+      }
+      print_or(*r, [](const Json& s) {
+        const Json feed = s.value("feed_mm_per_s", Json());
+        fmt::print("{}  {}  F{}  line {}  job {}{}\n", s.value("state", "?"), position_text(s.value("position", Json())),
+                   feed.is_number() ? fmt::format("{:.0f} mm/min", feed.get<double>() * 60) : std::string("-"),
+                   s.value("program_line", Json(0)).dump(), s.value("job", Json()).is_string() ? s["job"].get<std::string>() : "-",
+                   s.contains("cell") && s["cell"].contains("fault") ? "  cell: " + s["cell"]["fault"].get<std::string>() : "");
+      });
+    });
+  }
+  for (const auto& [name, method, help] : std::vector<std::tuple<std::string, std::string, std::string>>{
+           {"hold", "machine.hold", "feed hold now (the job pauses; lamina continue goes on)"},
+           {"continue", "machine.resume", "continue after a hold (or resume the stopped job)"},
+           {"abort", "machine.abort", "stop the cut now: jet off, motion held; resume or cancel the job afterwards"}}) {
+    auto* cmd = app.add_subcommand(name, help);
+    add_common(cmd, *o);
+    cmd->callback([o, method, &exit_code, print_or] {
+      auto r = call(*o, method);
+      if (!r) {
+        exit_code = 1;
+        return;
+      }
+      print_or(*r, [](const Json& j) { fmt::print("{}\n", j.dump()); });
+    });
+  }
+}
+
+}  // namespace lamina::cli

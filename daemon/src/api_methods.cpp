@@ -1,0 +1,114 @@
+#include "api_methods.hpp"
+
+#include <functional>
+#include <map>
+
+#include <fmt/format.h>
+
+namespace lamina::daemon {
+namespace {
+
+using Json = nlohmann::json;
+using Method = std::function<RpcResult(const Json& params, ClientContext& client)>;
+
+RpcError invalid(std::string message) { return RpcError{rpc_code::invalid_params, std::move(message), nullptr}; }
+
+// params must be an object (positional arrays are not used by this API).
+std::expected<const Json*, RpcError> object_params(const Json& params) {
+  if (!params.is_object()) return std::unexpected(invalid("params: expected an object"));
+  return &params;
+}
+
+std::expected<std::string, RpcError> string_param(const Json& params, const char* key) {
+  auto it = params.find(key);
+  if (it == params.end()) return std::unexpected(invalid(fmt::format("params.{}: missing", key)));
+  if (!it->is_string() || it->get<std::string>().empty())
+    return std::unexpected(invalid(fmt::format("params.{}: expected a non-empty string", key)));
+  return it->get<std::string>();
+}
+
+std::expected<int, RpcError> int_param(const Json& params, const char* key) {
+  auto it = params.find(key);
+  if (it == params.end()) return std::unexpected(invalid(fmt::format("params.{}: missing", key)));
+  if (!it->is_number_integer()) return std::unexpected(invalid(fmt::format("params.{}: expected an integer", key)));
+  return it->get<int>();
+}
+
+RpcResult job_result(std::expected<JobRecord, RpcError> r) {
+  if (!r) return std::unexpected(r.error());
+  return to_json(*r);
+}
+
+}  // namespace
+
+RpcServer::Handler make_api_handler(JobManager& jobs, ServerInfo info) {
+  auto methods = std::make_shared<std::map<std::string, Method>>();
+  auto& m = *methods;
+
+  m["server.info"] = [info](const Json&, ClientContext&) -> RpcResult {
+    return Json{{"name", "laminad"}, {"version", info.version}, {"machine", info.machine}, {"state_dir", info.state_dir},
+                {"api", 1}};
+  };
+  m["server.subscribe"] = [](const Json&, ClientContext& client) -> RpcResult {
+    client.subscribed = true;
+    return Json{{"subscribed", true}, {"notifications", {"notify_job_progress", "notify_machine_status"}}};
+  };
+  m["job.submit"] = [&jobs](const Json& params, ClientContext&) -> RpcResult {
+    auto p = object_params(params);
+    if (!p) return std::unexpected(p.error());
+    auto model = string_param(params, "model");
+    if (!model) return std::unexpected(model.error());
+    SubmitRequest r;
+    r.model_path = *model;
+    if (auto it = params.find("name"); it != params.end()) {
+      if (!it->is_string()) return std::unexpected(invalid("params.name: expected a string"));
+      r.name = it->get<std::string>();
+    }
+    if (auto it = params.find("settings"); it != params.end()) r.settings = *it;
+    for (const auto& [key, value] : params.items())
+      if (key != "model" && key != "name" && key != "settings")
+        return std::unexpected(invalid(fmt::format("params.{}: unknown parameter", key)));
+    return job_result(jobs.submit(std::move(r)));
+  };
+  m["job.list"] = [&jobs](const Json&, ClientContext&) -> RpcResult {
+    Json list = Json::array();
+    for (const JobRecord& j : jobs.list())
+      list.push_back({{"id", j.id}, {"state", to_string(j.state)}, {"name", j.name}, {"current_sheet", j.current_sheet},
+                      {"sheets", j.sheets.size()}, {"error", j.error}, {"created_unix_ms", j.created_unix_ms}});
+    return list;
+  };
+  auto with_job = [&jobs](std::function<std::expected<JobRecord, RpcError>(const std::string&, const Json&)> f) {
+    return [f](const Json& params, ClientContext&) -> RpcResult {
+      auto p = object_params(params);
+      if (!p) return std::unexpected(p.error());
+      auto id = string_param(params, "job");
+      if (!id) return std::unexpected(id.error());
+      return job_result(f(*id, params));
+    };
+  };
+  m["job.get"] = with_job([&jobs](const std::string& id, const Json&) { return jobs.get(id); });
+  m["job.cancel"] = with_job([&jobs](const std::string& id, const Json&) { return jobs.cancel(id); });
+  m["job.resume"] = with_job([&jobs](const std::string& id, const Json&) { return jobs.resume(id); });
+  m["job.confirm_sheet"] = with_job([&jobs](const std::string& id, const Json& params) -> std::expected<JobRecord, RpcError> {
+    auto sheet = int_param(params, "sheet");
+    if (!sheet) return std::unexpected(sheet.error());
+    return jobs.confirm_sheet(id, *sheet);
+  });
+  m["machine.status"] = [&jobs](const Json&, ClientContext&) -> RpcResult { return jobs.machine_status(); };
+  m["machine.hold"] = [&jobs](const Json&, ClientContext&) -> RpcResult { return jobs.hold(); };
+  m["machine.resume"] = [&jobs](const Json&, ClientContext&) -> RpcResult { return jobs.resume_motion(); };
+  m["machine.abort"] = [&jobs](const Json& params, ClientContext&) -> RpcResult {
+    std::string why = "aborted by the operator";
+    if (params.is_object() && params.contains("reason") && params["reason"].is_string()) why = params["reason"];
+    return jobs.abort(why);
+  };
+
+  return [methods](const RpcRequest& request, ClientContext& client) -> RpcResult {
+    auto it = methods->find(request.method);
+    if (it == methods->end())
+      return std::unexpected(RpcError{rpc_code::method_not_found, fmt::format("no method '{}'", request.method), nullptr});
+    return it->second(request.params, client);
+  };
+}
+
+}  // namespace lamina::daemon

@@ -1,0 +1,434 @@
+// JobManager: the RPC-facing half (submit, list, cancel, confirm, resume, machine requests) and
+// planning. The cutting thread is in job_cutting.cpp.
+#include "job_manager.hpp"
+
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <random>
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include "plan_process.hpp"
+#include "plan_settings.hpp"
+
+namespace lamina::daemon {
+namespace fs = std::filesystem;
+
+namespace {
+
+std::int64_t now_unix_ms() {
+  return std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+std::string new_job_id() {
+  static std::mt19937 rng{std::random_device{}()};
+  return fmt::format("j-{}-{:04x}", now_unix_ms(), rng() & 0xFFFF);
+}
+
+RpcError error(int code, std::string message) { return RpcError{code, std::move(message), nullptr}; }
+
+std::shared_ptr<spdlog::logger> log() {
+  static auto logger = [] {
+    auto l = spdlog::get("jobs");
+    return l ? l : spdlog::default_logger()->clone("jobs");
+  }();
+  return logger;
+}
+
+// Which transitions the state machine allows (docs/api.md "Job states").
+bool allowed(JobState from, JobState to) {
+  using S = JobState;
+  if (to == S::cancelled) return !is_terminal(from);
+  if (to == S::interrupted) return from == S::cutting || from == S::paused || from == S::sheet_done || from == S::waiting_sheet;
+  switch (from) {
+    case S::queued: return to == S::planning;
+    case S::planning: return to == S::planned || to == S::failed || to == S::queued;
+    case S::planned: return to == S::waiting_sheet;
+    case S::waiting_sheet: return to == S::cutting;
+    case S::cutting: return to == S::paused || to == S::sheet_done || to == S::completed;
+    case S::paused: return to == S::cutting || to == S::paused || to == S::sheet_done || to == S::completed;
+    case S::sheet_done: return to == S::waiting_sheet || to == S::completed;
+    case S::interrupted: return to == S::cutting;
+    default: return false;
+  }
+}
+
+std::string model_name(const std::string& path) { return fs::path(path).filename().string(); }
+
+}  // namespace
+
+JobManager::JobManager(const DaemonConfig& config, JobStore& store, MachineSession& machine, Notifier notify)
+    : config_(config), store_(store), machine_(machine), notify_(std::move(notify)) {}
+
+JobManager::~JobManager() { shutdown("daemon stopping"); }
+
+std::expected<void, RpcError> JobManager::start() {
+  auto all = store_.list_jobs();
+  if (!all) return std::unexpected(error(rpc_code::storage_error, all.error().message));
+  std::lock_guard lock(mutex_);
+  for (JobRecord& job : *all) {
+    if (job.state == JobState::queued) plan_queue_.push_back(job.id);
+    jobs_[job.id] = std::move(job);
+  }
+  const int workers = std::max(1, config_.planner.workers);
+  for (int i = 0; i < workers; ++i) planners_.emplace_back([this] { planner_loop(); });
+  assign_machine();
+  return {};
+}
+
+void JobManager::shutdown(const std::string& why) {
+  drivers::CutJob* cut = nullptr;
+  {
+    std::lock_guard lock(mutex_);
+    if (stopping_ && planners_.empty() && !cutter_.joinable()) return;
+    stopping_ = true;
+    for (auto& [id, flag] : plan_cancel_) flag->store(true);
+    if (cutting_) cut = cut_.get();
+  }
+  plan_wake_.notify_all();
+  if (cut) cut->abort(why);  // the cutter thread marks its job interrupted (stopping_)
+  for (auto& t : planners_)
+    if (t.joinable()) t.join();
+  planners_.clear();
+  if (cutter_.joinable()) cutter_.join();
+  std::lock_guard lock(mutex_);
+  // A job that owned the machine but was not streaming (held, waiting) is interrupted too:
+  // after a restart nobody may assume its sheet is still where it was.
+  if (JobRecord* job = find(machine_job_); job && (job->state == JobState::paused || job->state == JobState::sheet_done))
+    (void)set_state(*job, JobState::interrupted, why);
+}
+
+// ---------------------------------------------------------------------------- state machine
+
+std::expected<void, RpcError> JobManager::set_state(JobRecord& job, JobState to, const std::string& why) {
+  if (!allowed(job.state, to))
+    return std::unexpected(error(rpc_code::invalid_state, fmt::format("job {} is {}: it cannot become {}", job.id,
+                                                                      to_string(job.state), to_string(to))));
+  const JobState from = job.state;
+  job.state = to;
+  job.updated_unix_ms = now_unix_ms();
+  if (!why.empty() || to == JobState::cutting || to == JobState::completed) job.error = why;
+  persist(job);
+  event(job, "state", {{"from", to_string(from)}, {"to", to_string(to)}, {"reason", why}});
+  log()->info("job {}: {} → {}{}", job.id, to_string(from), to_string(to), why.empty() ? "" : " (" + why + ")");
+  announce(job);
+  return {};
+}
+
+void JobManager::persist(const JobRecord& job) {
+  if (auto r = store_.update_job(job); !r) log()->error("job {}: not saved: {}", job.id, r.error().message);
+}
+
+void JobManager::event(const JobRecord& job, const std::string& kind, nlohmann::json data) {
+  if (auto r = store_.add_event(JobEvent{job.id, now_unix_ms(), kind, std::move(data)}); !r)
+    log()->error("job {}: event not saved: {}", job.id, r.error().message);
+}
+
+void JobManager::announce(const JobRecord& job) {
+  if (notify_) notify_("notify_job_progress", to_json(job));
+}
+
+JobRecord* JobManager::find(const std::string& id) {
+  auto it = jobs_.find(id);
+  return it == jobs_.end() ? nullptr : &it->second;
+}
+const JobRecord* JobManager::find(const std::string& id) const {
+  auto it = jobs_.find(id);
+  return it == jobs_.end() ? nullptr : &it->second;
+}
+
+void JobManager::assign_machine() {
+  if (!machine_job_.empty() || stopping_) return;
+  JobRecord* oldest = nullptr;
+  for (auto& [id, job] : jobs_)
+    if (job.state == JobState::planned && (!oldest || job.created_unix_ms < oldest->created_unix_ms)) oldest = &job;
+  if (!oldest) return;
+  machine_job_ = oldest->id;
+  oldest->current_sheet = 0;
+  for (const SheetRecord& s : oldest->sheets)
+    if (s.state != SheetState::done) {
+      oldest->current_sheet = s.index;
+      break;
+    }
+  (void)set_state(*oldest, JobState::waiting_sheet,
+                  fmt::format("load sheet {} and confirm it", oldest->current_sheet));
+}
+
+// ---------------------------------------------------------------------------- requests
+
+std::expected<JobRecord, RpcError> JobManager::submit(SubmitRequest r) {
+  if (r.model_path.empty() || r.model_path.front() != '/')
+    return std::unexpected(error(rpc_code::invalid_params, "model: expected an absolute path on the cell PC"));
+  if (::access(r.model_path.c_str(), R_OK) != 0)
+    return std::unexpected(error(rpc_code::invalid_params, fmt::format("model: cannot read {}", r.model_path)));
+  auto args = plan_args_from_settings(r.settings);
+  if (!args) return std::unexpected(error(rpc_code::invalid_params, args.error()));
+
+  std::lock_guard lock(mutex_);
+  if (stopping_) return std::unexpected(error(rpc_code::shutting_down, "the daemon is stopping"));
+  JobRecord job;
+  job.id = new_job_id();
+  job.model_path = r.model_path;
+  job.name = r.name.empty() ? model_name(r.model_path) : r.name;
+  job.plan_settings = r.settings.is_null() ? nlohmann::json::object() : r.settings;
+  job.artefact_dir = (config_.state_dir / "jobs" / job.id).string();
+  job.created_unix_ms = job.updated_unix_ms = now_unix_ms();
+  if (auto s = store_.insert_job(job); !s) return std::unexpected(error(rpc_code::storage_error, s.error().message));
+  event(job, "state", {{"from", nullptr}, {"to", "queued"}, {"reason", "submitted"}});
+  log()->info("job {}: queued ({})", job.id, job.model_path);
+  jobs_[job.id] = job;
+  plan_queue_.push_back(job.id);
+  plan_wake_.notify_one();
+  announce(job);
+  return job;
+}
+
+std::vector<JobRecord> JobManager::list() const {
+  std::lock_guard lock(mutex_);
+  std::vector<JobRecord> out;
+  for (const auto& [id, job] : jobs_) out.push_back(job);
+  std::sort(out.begin(), out.end(), [](const JobRecord& a, const JobRecord& b) {
+    return a.created_unix_ms != b.created_unix_ms ? a.created_unix_ms < b.created_unix_ms : a.id < b.id;
+  });
+  return out;
+}
+
+std::expected<JobRecord, RpcError> JobManager::get(const std::string& id) const {
+  std::lock_guard lock(mutex_);
+  const JobRecord* job = find(id);
+  if (!job) return std::unexpected(error(rpc_code::job_not_found, fmt::format("no job {}", id)));
+  return *job;
+}
+
+std::expected<JobRecord, RpcError> JobManager::cancel(const std::string& id) {
+  drivers::CutJob* cut = nullptr;
+  JobRecord copy;
+  {
+    std::lock_guard lock(mutex_);
+    JobRecord* job = find(id);
+    if (!job) return std::unexpected(error(rpc_code::job_not_found, fmt::format("no job {}", id)));
+    if (is_terminal(job->state))
+      return std::unexpected(error(rpc_code::invalid_state, fmt::format("job {} is already {}", id, to_string(job->state))));
+    if (job->state == JobState::planning) {
+      if (auto it = plan_cancel_.find(id); it != plan_cancel_.end()) it->second->store(true);
+      return *job;  // the planner worker marks it cancelled when the child has stopped
+    }
+    if (id == machine_job_ && cutting_) {
+      cancel_after_stop_ = id;
+      cut = cut_.get();
+      copy = *job;
+    } else {
+      std::erase(plan_queue_, id);
+      const bool owned = id == machine_job_;
+      if (auto s = set_state(*job, JobState::cancelled, "cancelled by the operator"); !s) return std::unexpected(s.error());
+      if (owned) {
+        machine_job_.clear();
+        cut_.reset();
+        // The stop left the pump running for a resume; nobody will resume now. Blocking Modbus
+        // work stays off the io thread: the cutter slot is free (nothing is cutting).
+        if (machine_.cell() && !cutter_.joinable())
+          cutter_ = std::thread([cell = machine_.cell()] { (void)cell->finish_cut(); });
+        assign_machine();
+      }
+      return *job;
+    }
+  }
+  cut->abort("job cancelled by the operator");  // the cutting thread finishes the cancel
+  return copy;
+}
+
+std::expected<JobRecord, RpcError> JobManager::confirm_sheet(const std::string& id, int sheet) {
+  std::lock_guard lock(mutex_);
+  JobRecord* job = find(id);
+  if (!job) return std::unexpected(error(rpc_code::job_not_found, fmt::format("no job {}", id)));
+  if (job->state != JobState::waiting_sheet)
+    return std::unexpected(error(rpc_code::invalid_state,
+                                 fmt::format("job {} is {}, not waiting for a sheet", id, to_string(job->state))));
+  if (sheet != job->current_sheet)
+    return std::unexpected(error(rpc_code::invalid_params,
+                                 fmt::format("sheet {}: job {} waits for sheet {}", sheet, id, job->current_sheet)));
+  start_cut(*job, CutStart::fresh);
+  return *job;
+}
+
+std::expected<JobRecord, RpcError> JobManager::resume(const std::string& id) {
+  std::lock_guard lock(mutex_);
+  JobRecord* job = find(id);
+  if (!job) return std::unexpected(error(rpc_code::job_not_found, fmt::format("no job {}", id)));
+  if (job->state == JobState::paused && pause_ == PauseKind::hold && cutting_) {
+    drivers::CutJob* cut = cut_.get();
+    cut->continue_motion();
+    if (machine_.cell()) machine_.cell()->cycle_start();
+    pause_ = PauseKind::none;
+    (void)set_state(*job, JobState::cutting);
+    return *job;
+  }
+  if (job->state == JobState::paused) {
+    if (cutting_) return std::unexpected(error(rpc_code::machine_busy, "the cut is still stopping; try again"));
+    start_cut(*job, CutStart::resume_stopped);
+    return *job;
+  }
+  if (job->state == JobState::interrupted) {
+    if (!machine_job_.empty() && machine_job_ != id)
+      return std::unexpected(error(rpc_code::machine_busy, fmt::format("the machine is with job {}", machine_job_)));
+    machine_job_ = id;
+    start_cut(*job, CutStart::resume_interrupted);
+    return *job;
+  }
+  return std::unexpected(error(rpc_code::invalid_state,
+                               fmt::format("job {} is {}: only paused or interrupted jobs resume", id, to_string(job->state))));
+}
+
+nlohmann::json JobManager::machine_status() const {
+  nlohmann::json status = machine_.status();
+  std::lock_guard lock(mutex_);
+  status["job"] = machine_job_.empty() ? nlohmann::json(nullptr) : nlohmann::json(machine_job_);
+  if (const JobRecord* job = find(machine_job_)) {
+    status["job_state"] = to_string(job->state);
+    status["sheet"] = job->current_sheet;
+    for (const SheetRecord& s : job->sheets)
+      if (s.index == job->current_sheet) status["program_line"] = s.last_acked_line;
+  }
+  return status;
+}
+
+std::expected<nlohmann::json, RpcError> JobManager::hold() {
+  drivers::CutJob* cut = nullptr;
+  {
+    std::lock_guard lock(mutex_);
+    JobRecord* job = find(machine_job_);
+    if (!job || job->state != JobState::cutting || !cutting_)
+      return std::unexpected(error(rpc_code::invalid_state, "nothing is cutting"));
+    cut = cut_.get();
+    pause_ = PauseKind::hold;
+    (void)set_state(*job, JobState::paused, "held by the operator");
+  }
+  cut->hold();
+  if (machine_.cell()) machine_.cell()->feed_hold();  // a drip feed has no hold on its line
+  return nlohmann::json{{"held", true}};
+}
+
+std::expected<nlohmann::json, RpcError> JobManager::resume_motion() {
+  std::string id;
+  {
+    std::lock_guard lock(mutex_);
+    id = machine_job_;
+  }
+  if (id.empty()) return std::unexpected(error(rpc_code::invalid_state, "no job has the machine"));
+  auto r = resume(id);
+  if (!r) return std::unexpected(r.error());
+  return to_json(*r);
+}
+
+std::expected<nlohmann::json, RpcError> JobManager::abort(const std::string& why) {
+  drivers::CutJob* cut = nullptr;
+  {
+    std::lock_guard lock(mutex_);
+    if (!cutting_) return std::unexpected(error(rpc_code::invalid_state, "nothing is cutting"));
+    cut = cut_.get();
+  }
+  cut->abort(why);  // the cut stops safely; its job becomes paused with a resume point
+  return nlohmann::json{{"aborted", true}};
+}
+
+std::string JobManager::status_line() const {
+  std::lock_guard lock(mutex_);
+  int queued = 0;
+  for (const auto& [id, job] : jobs_) queued += job.state == JobState::queued || job.state == JobState::planned;
+  const JobRecord* job = find(machine_job_);
+  if (!job) return fmt::format("idle, {} job(s) waiting", queued);
+  return fmt::format("job {} {} sheet {}/{}, {} waiting", job->id, to_string(job->state), job->current_sheet,
+                     job->sheets.size(), queued);
+}
+
+// ---------------------------------------------------------------------------- planning
+
+void JobManager::planner_loop() {
+  while (true) {
+    std::string id;
+    {
+      std::unique_lock lock(mutex_);
+      plan_wake_.wait(lock, [this] { return stopping_ || !plan_queue_.empty(); });
+      if (stopping_) return;
+      id = plan_queue_.front();
+      plan_queue_.pop_front();
+    }
+    plan_job(id);
+  }
+}
+
+void JobManager::plan_job(const std::string& id) {
+  auto cancel = std::make_shared<std::atomic<bool>>(false);
+  PlanProcessRequest request;
+  {
+    std::lock_guard lock(mutex_);
+    JobRecord* job = find(id);
+    if (!job || job->state != JobState::queued) return;
+    plan_cancel_[id] = cancel;
+    if (!set_state(*job, JobState::planning)) return;
+    request.lamina = config_.planner.lamina_path;
+    request.model = job->model_path;
+    request.out_dir = job->artefact_dir;
+    request.flags = plan_args_from_settings(job->plan_settings).value_or(PlanArgs{}).flags;
+    if (!config_.planner.machine_file.empty()) request.flags.insert(request.flags.end(), {"--machine", config_.planner.machine_file});
+    if (!config_.planner.materials_file.empty())
+      request.flags.insert(request.flags.end(), {"--materials", config_.planner.materials_file});
+    request.timeout_s = config_.planner.timeout_s;
+  }
+  auto report = run_plan_process(request, *cancel);
+
+  std::lock_guard lock(mutex_);
+  plan_cancel_.erase(id);
+  JobRecord* job = find(id);
+  if (!job) return;
+  if (!report) {
+    if (stopping_ && !report.error().cancelled) return;
+    if (report.error().cancelled && stopping_) {
+      (void)set_state(*job, JobState::queued, "planning stopped with the daemon; planned again at start");
+      return;
+    }
+    (void)set_state(*job, report.error().cancelled ? JobState::cancelled : JobState::failed, report.error().message);
+    return;
+  }
+  const nlohmann::json& r = *report;
+  job->sheets.clear();
+  std::size_t lines = 0;
+  double estimate_s = 0;
+  for (const auto& s : r.value("sheets", nlohmann::json::array())) {
+    SheetRecord sheet;
+    sheet.index = s.value("index", 0);
+    sheet.program_path = (fs::path(job->artefact_dir) / s.value("program", "")).string();
+    sheet.svg_path = (fs::path(job->artefact_dir) / s.value("svg", "")).string();
+    sheet.material = s.value("material", "");
+    sheet.thickness_mm = s.value("thickness_mm", 0.0);
+    std::ifstream in(sheet.program_path);
+    for (std::string line; std::getline(in, line);) sheet.lines_total += !line.empty() && line != "\r";
+    lines += sheet.lines_total;
+    estimate_s += s.value("estimated_time_s", 0.0);
+    job->sheets.push_back(std::move(sheet));
+  }
+  if (job->sheets.empty()) {
+    (void)set_state(*job, JobState::failed, "the plan has no sheets to cut (see plan.log)");
+    return;
+  }
+  nlohmann::json deviation = nlohmann::json::object();
+  for (const auto& [strategy, d] : r.value("deviation", nlohmann::json::object()).items())
+    deviation[strategy] = {{"volume_pct", d.value("volume_pct", 0.0)}, {"max_mm", d.value("max_mm", 0.0)}};
+  job->summary = {{"layers", r.contains("layers") ? r["layers"].size() : 0},
+                  {"sheets", job->sheets.size()},
+                  {"lines", lines},
+                  {"estimated_cut_s", estimate_s},
+                  {"deviation", deviation},
+                  {"stack", (fs::path(job->artefact_dir) / "stack.stl").string()},
+                  {"report", (fs::path(job->artefact_dir) / "report.json").string()},
+                  {"warnings", r.value("warnings", nlohmann::json::array())}};
+  (void)set_state(*job, JobState::planned);
+  assign_machine();
+}
+
+}  // namespace lamina::daemon

@@ -1,0 +1,111 @@
+#pragma once
+// The jobs of the cell and their state machine (docs/api.md "Job states"). Called from the RPC
+// handlers on the io thread (every public method returns quickly), it plans on worker threads
+// (lamina plan as a child process) and cuts on one cutting thread through the MachineSession.
+// Every state change is written to the JobStore before it is announced.
+#include <atomic>
+#include <condition_variable>
+#include <deque>
+#include <expected>
+#include <functional>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "lamina/daemon/daemon_config.hpp"
+#include "lamina/daemon/job_model.hpp"
+#include "lamina/daemon/job_store.hpp"
+#include "lamina/daemon/rpc_server.hpp"
+#include "lamina/drivers/cut_job.hpp"
+#include "machine_session.hpp"
+
+namespace lamina::daemon {
+
+struct SubmitRequest {
+  std::string model_path;             // absolute, readable by the daemon
+  std::string name;                   // for people; default: the file name
+  nlohmann::json settings = nlohmann::json::object();  // plan settings (plan_settings.hpp)
+};
+
+class JobManager {
+ public:
+  // notify(method, params): notify_job_progress / notify_machine_status to subscribed clients.
+  using Notifier = std::function<void(const std::string& method, const nlohmann::json& params)>;
+
+  JobManager(const DaemonConfig& config, JobStore& store, MachineSession& machine, Notifier notify);
+  ~JobManager();  // shutdown() if not done
+  JobManager(const JobManager&) = delete;
+  JobManager& operator=(const JobManager&) = delete;
+
+  // Loads the jobs (after JobStore::recover_after_restart), starts the planner workers.
+  std::expected<void, RpcError> start();
+  // SIGTERM: stop planning, stop the cut safely (its job becomes interrupted), wait for threads.
+  void shutdown(const std::string& why);
+
+  std::expected<JobRecord, RpcError> submit(SubmitRequest request);
+  std::vector<JobRecord> list() const;
+  std::expected<JobRecord, RpcError> get(const std::string& id) const;
+  std::expected<JobRecord, RpcError> cancel(const std::string& id);
+  std::expected<JobRecord, RpcError> confirm_sheet(const std::string& id, int sheet);
+  std::expected<JobRecord, RpcError> resume(const std::string& id);  // paused or interrupted
+
+  nlohmann::json machine_status() const;
+  std::expected<nlohmann::json, RpcError> hold();
+  std::expected<nlohmann::json, RpcError> resume_motion();
+  std::expected<nlohmann::json, RpcError> abort(const std::string& why);
+
+  std::string status_line() const;  // for sd_notify STATUS=
+
+ private:
+  enum class CutStart { fresh, resume_stopped, resume_interrupted };
+  enum class PauseKind { none, hold, stopped };
+
+  // --- under mutex_ ---
+  std::expected<void, RpcError> set_state(JobRecord& job, JobState to, const std::string& why = {});
+  void persist(const JobRecord& job);
+  void event(const JobRecord& job, const std::string& kind, nlohmann::json data);
+  void announce(const JobRecord& job);
+  void assign_machine();              // the oldest planned job gets the machine when it is free
+  JobRecord* find(const std::string& id);
+  const JobRecord* find(const std::string& id) const;
+  void start_cut(JobRecord& job, CutStart how);
+
+  // --- threads ---
+  void planner_loop();
+  void plan_job(const std::string& id);
+  void cut_sheet(std::string job_id, int sheet, CutStart how, std::vector<std::string> program,
+                 std::optional<std::size_t> resume_line);
+  void finish_cut(const std::string& job_id, int sheet, const drivers::CutReport& report);
+  void save_progress(const std::string& job_id, int sheet, const drivers::CutReport& report);
+  std::size_t interrupted_resume_line(const SheetRecord& sheet, const std::vector<std::string>& program,
+                                      std::string& note);
+
+  DaemonConfig config_;
+  JobStore& store_;
+  MachineSession& machine_;
+  Notifier notify_;
+
+  mutable std::mutex mutex_;
+  std::condition_variable plan_wake_;
+  std::map<std::string, JobRecord> jobs_;
+  std::deque<std::string> plan_queue_;
+  std::map<std::string, std::shared_ptr<std::atomic<bool>>> plan_cancel_;
+  std::vector<std::thread> planners_;
+  bool stopping_ = false;
+
+  std::string machine_job_;           // the job that owns the machine (empty: free)
+  std::string cancel_after_stop_;     // cancel this job when its cut has stopped
+  std::unique_ptr<drivers::CutJob> cut_;  // the cut of machine_job_'s current sheet
+  std::thread cutter_;
+  bool cutting_ = false;              // cutter_ is streaming
+  PauseKind pause_ = PauseKind::none;
+  std::chrono::steady_clock::time_point last_saved_{}, last_announced_{};
+};
+
+}  // namespace lamina::daemon

@@ -1,0 +1,112 @@
+#include "machine_session.hpp"
+
+#include <stdexcept>
+
+#include <boost/asio/io_context.hpp>
+#include <fmt/format.h>
+
+#include "lamina/drivers/modbus_block_link.hpp"
+#include "lamina/drivers/streamer.hpp"
+
+namespace lamina::daemon {
+namespace {
+
+std::pair<std::string, int> host_port(const std::string& text, const char* what) {
+  const auto colon = text.rfind(':');
+  if (colon == std::string::npos || colon == 0) throw std::invalid_argument(fmt::format("{} '{}': expected HOST:PORT", what, text));
+  try {
+    return {text.substr(0, colon), std::stoi(text.substr(colon + 1))};
+  } catch (const std::exception&) {
+    throw std::invalid_argument(fmt::format("{} '{}': the port is not a number", what, text));
+  }
+}
+
+nlohmann::json position_json(const std::optional<std::array<double, 5>>& p) {
+  if (!p) return nullptr;
+  return {{"x_mm", (*p)[0]}, {"y_mm", (*p)[1]}, {"z_mm", (*p)[2]}, {"a_deg", (*p)[3]}, {"c_deg", (*p)[4]}};
+}
+
+}  // namespace
+
+MachineSession::MachineSession(const DaemonConfig& config) : link_config_(config.link) {
+  const MachineLinkConfig& l = config.link;
+  if (l.protocol == "modbus") {
+    drivers::ModbusBlockSettings s;
+    std::tie(s.host, s.port) = host_port(config.cell.modbus, "[cell] modbus");
+    s.status_period_s = 1.0 / l.status_hz;
+    link_ = std::make_unique<drivers::ModbusBlockLink>(s);
+    describe_ = fmt::format("Modbus mailbox on {}", config.cell.modbus);
+  } else {
+    std::unique_ptr<drivers::LineProtocol> protocol;
+    if (l.protocol == "grbl") protocol = drivers::make_grbl_protocol({l.rx_buffer});
+    else if (l.protocol == "send-response") protocol = drivers::make_send_response_protocol();
+    else if (l.protocol == "xonxoff") protocol = drivers::make_xonxoff_protocol();
+    else throw std::invalid_argument(fmt::format("[link] protocol '{}' is unknown", l.protocol));
+    drivers::StreamerSettings settings;
+    settings.status_period_s = l.protocol == "xonxoff" ? 0 : 1.0 / l.status_hz;
+    drivers::TransportFactory open;
+    if (!l.port.empty()) {
+      drivers::SerialSettings serial;
+      serial.baud = l.baud;
+      settings.pace_bytes_per_s = l.baud / 10.0;  // 8N1
+      open = [port = l.port, serial](boost::asio::io_context& io) { return drivers::open_serial(io, port, serial); };
+      describe_ = fmt::format("{} on {} at {} baud", l.protocol, l.port, l.baud);
+    } else {
+      const auto [host, port] = host_port(l.tcp, "[link] tcp");
+      open = [host, port](boost::asio::io_context& io) { return drivers::open_tcp(io, host, port); };
+      describe_ = fmt::format("{} on tcp {}", l.protocol, l.tcp);
+    }
+    link_ = std::make_unique<drivers::Streamer>(std::move(open), std::move(protocol), settings);
+  }
+  if (config.cell.enabled) {
+    drivers::CellIoSettings cs;
+    std::tie(cs.host, cs.port) = host_port(config.cell.modbus, "[cell] modbus");
+    cs.heartbeat_period_s = config.cell.heartbeat_period_s;
+    cs.pump_ready_timeout_s = config.cell.pump_ready_timeout_s;
+    cs.pressure_setpoint_01mpa = static_cast<std::uint16_t>(config.cell.pressure_setpoint_mpa * 10 + 0.5);
+    cs.abrasive_g_per_min = static_cast<std::uint16_t>(config.cell.abrasive_g_per_min + 0.5);
+    cell_ = std::make_unique<drivers::CellIo>(cs);
+    describe_ += fmt::format(", PLC {}", config.cell.modbus);
+  }
+}
+
+drivers::CutJobSettings MachineSession::cut_settings() const {
+  drivers::CutJobSettings s;
+  s.wait_for_idle = link_config_.protocol != "xonxoff";  // a drip feed reports no status
+  return s;
+}
+
+nlohmann::json MachineSession::status() const {
+  const drivers::LinkProgress p = link_->progress();
+  nlohmann::json j{{"link", describe_}, {"state", "unknown"}};
+  if (p.last_status) {
+    const drivers::ControllerStatus& s = *p.last_status;
+    j["state"] = drivers::to_string(s.state);
+    j["state_text"] = s.state_text;
+    j["position"] = position_json(s.machine_position);
+    j["feed_mm_per_s"] = s.feed_mm_per_s ? nlohmann::json(*s.feed_mm_per_s) : nlohmann::json(nullptr);
+    j["line"] = s.line_number ? nlohmann::json(*s.line_number) : nlohmann::json(nullptr);
+    j["planner_blocks_free"] = s.planner_blocks_free ? nlohmann::json(*s.planner_blocks_free) : nlohmann::json(nullptr);
+  }
+  j["lines_sent"] = p.lines_sent;
+  j["lines_accepted"] = p.lines_accepted;
+  if (cell_) {
+    const drivers::CellStatus c = cell_->status();
+    if (!p.last_status) j["state"] = drivers::to_string(c.cnc_state);
+    j["cell"] = {{"connected", c.connected},
+                 {"estop_ok", c.estop_ok},
+                 {"door_closed", c.door_closed},
+                 {"pump_ready", c.pump_ready},
+                 {"jet_is_on", c.jet_is_on},
+                 {"pressure_mpa", c.pressure_mpa},
+                 {"abrasive_g_per_min", c.abrasive_g_per_min},
+                 {"alarm_latched", c.alarm_latched},
+                 {"alarm_code", c.alarm_code}};
+    if (const auto f = cell_->fault()) j["cell"]["fault"] = f->message;
+  }
+  return j;
+}
+
+std::string MachineSession::describe() const { return describe_; }
+
+}  // namespace lamina::daemon

@@ -1,0 +1,34 @@
+#pragma once
+// Planning runs `lamina plan` as a child process, not in the daemon: a hostile or huge mesh can
+// exhaust memory or crash the planner without touching the daemon, a cancel is a signal, and
+// the memory of a plan is returned to the system when it ends. The child writes its programs,
+// drawings, stack.stl and report.json into the job's folder; its output goes to plan.log there.
+#include <atomic>
+#include <expected>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+namespace lamina::daemon {
+
+struct PlanProcessRequest {
+  std::filesystem::path lamina;       // the `lamina` program
+  std::filesystem::path model;
+  std::filesystem::path out_dir;
+  std::vector<std::string> flags;     // from plan_args_from_settings, plus machine/materials
+  double timeout_s = 3600;
+};
+
+struct PlanProcessError {
+  bool cancelled = false;
+  std::string message;  // the planner's last error lines, or what failed around it
+};
+
+// Blocking (a worker thread). Returns report.json as parsed. `cancel` is polled every 50 ms:
+// SIGTERM, then SIGKILL 2 s later.
+std::expected<nlohmann::json, PlanProcessError> run_plan_process(const PlanProcessRequest& request,
+                                                                 const std::atomic<bool>& cancel);
+
+}  // namespace lamina::daemon

@@ -1,0 +1,185 @@
+#pragma once
+// laminad as the shop runs it, against lamina-sim: the simulator (CNC on a PTY, PLC on Modbus)
+// and the daemon as separate processes, a config written per test, clients over the socket.
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "lamina/daemon/rpc_client.hpp"
+#include "sim_process.hpp"
+
+extern char** environ;
+
+namespace lamina::daemon::testing {
+
+using sim::testing::SimProcess;
+using sim::testing::TempDir;
+using Json = nlohmann::json;
+
+inline double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// The simulated cell, fast: 20× time, 921600 baud (the link is not what these tests measure).
+struct Cell {
+  explicit Cell(std::vector<std::string> extra = {}, double time_scale = 20)
+      : sim([&] {
+          std::vector<std::string> args{"--link", dir.file("cnc"), "--modbus", "127.0.0.1:0", "--control", "127.0.0.1:0",
+                                        "--log", dir.file("exec.jsonl"), "--pressure-ramp", "0.2", "--baud", "921600",
+                                        "--time-scale", fmt::format("{}", time_scale), "--heartbeat-timeout", "1000"};
+          args.insert(args.end(), extra.begin(), extra.end());
+          return args;
+        }()) {}
+  TempDir dir;  // before sim: it outlives the process
+  SimProcess sim;
+
+  std::string config(const std::string& extra_server = "") const {
+    return fmt::format(R"(state_dir = "{state}"
+[server]
+socket = "{sock}"
+socket_group = ""
+{extra}
+[link]
+protocol = "grbl"
+port = "{cnc}"
+baud = 921600
+[cell]
+modbus = "127.0.0.1:{modbus}"
+[planner]
+lamina = "{lamina}"
+)",
+                       fmt::arg("state", dir.file("state")), fmt::arg("sock", dir.file("lamina.sock")),
+                       fmt::arg("extra", extra_server), fmt::arg("cnc", dir.file("cnc")),
+                       fmt::arg("modbus", sim.modbus_port()), fmt::arg("lamina", LAMINA_CLI));
+  }
+  std::string socket() const { return dir.file("lamina.sock"); }
+  std::string log() const { return dir.file("exec.jsonl"); }
+};
+
+class Laminad {
+ public:
+  Laminad(const std::string& config_text, const std::string& dir, std::vector<std::string> env_extra = {})
+      : config_path_(dir + "/lamina.toml"), log_path_(dir + "/laminad.log") {
+    std::ofstream(config_path_) << config_text;
+    start(env_extra);
+  }
+  ~Laminad() { stop(SIGTERM); }
+
+  void start(const std::vector<std::string>& env_extra = {}) {
+    std::vector<std::string> args{LAMINAD, "--config", config_path_};
+    std::vector<char*> argv;
+    for (auto& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    std::vector<std::string> env_strings;
+    for (char** e = environ; *e; ++e) env_strings.emplace_back(*e);
+    env_strings.insert(env_strings.end(), env_extra.begin(), env_extra.end());
+    std::vector<char*> envp;
+    for (auto& e : env_strings) envp.push_back(e.data());
+    envp.push_back(nullptr);
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_addopen(&actions, 1, log_path_.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
+    posix_spawn_file_actions_adddup2(&actions, 1, 2);
+    if (posix_spawn(&pid_, LAMINAD, &actions, nullptr, argv.data(), envp.data()) != 0)
+      throw std::runtime_error("cannot start laminad");
+    posix_spawn_file_actions_destroy(&actions);
+  }
+
+  // Signal and wait (SIGKILL after 30 s); the exit status, or -signal.
+  int stop(int signal) {
+    if (pid_ <= 0) return 0;
+    ::kill(pid_, signal);
+    int status = 0;
+    const auto t0 = std::chrono::steady_clock::now();
+    while (::waitpid(pid_, &status, WNOHANG) != pid_) {
+      if (seconds_since(t0) > 30) {
+        ::kill(pid_, SIGKILL);
+        ::waitpid(pid_, &status, 0);
+        break;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    pid_ = -1;
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -WTERMSIG(status);
+  }
+  bool running() {
+    if (pid_ <= 0) return false;
+    int status = 0;
+    return ::waitpid(pid_, &status, WNOHANG) == 0;
+  }
+  std::string log() const {
+    std::ifstream in(log_path_);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  }
+
+ private:
+  std::string config_path_, log_path_;
+  pid_t pid_ = -1;
+};
+
+// A client once the daemon listens (it may still be starting).
+inline RpcClient connect(const std::string& socket, double wait_s = 20) {
+  const auto t0 = std::chrono::steady_clock::now();
+  while (true) {
+    auto c = RpcClient::connect_unix(socket);
+    if (c) return std::move(*c);
+    if (seconds_since(t0) > wait_s) throw std::runtime_error("laminad does not listen on " + socket + ": " + c.error());
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+}
+
+inline Json call_ok(RpcClient& c, const std::string& method, Json params = Json::object()) {
+  auto r = c.call(method, std::move(params), 30);
+  if (!r) throw std::runtime_error(fmt::format("{}: {} ({})", method, r.error().message, r.error().code));
+  return *r;
+}
+
+// Polls job.get until `ready` says so; the last answer (check its state in the test).
+inline Json wait_job(RpcClient& c, const std::string& id, const std::function<bool(const Json&)>& ready, double wait_s) {
+  const auto t0 = std::chrono::steady_clock::now();
+  Json j;
+  while (seconds_since(t0) < wait_s) {
+    j = call_ok(c, "job.get", {{"job", id}});
+    if (ready(j)) return j;
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  return j;
+}
+inline Json wait_state(RpcClient& c, const std::string& id, const std::string& state, double wait_s) {
+  return wait_job(c, id, [&](const Json& j) { return j["state"] == state || j["state"] == "failed"; }, wait_s);
+}
+
+// The program lines a sheet's file holds, as the daemon streams them (blank lines dropped).
+inline std::vector<std::string> program_lines(const std::string& path) {
+  std::vector<std::string> lines;
+  std::ifstream in(path);
+  for (std::string line; std::getline(in, line);) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (!line.empty()) lines.push_back(line);
+  }
+  return lines;
+}
+
+struct LogBlock {
+  std::string line;
+  bool completed;
+};
+inline std::vector<LogBlock> executed(const std::string& log) {
+  std::vector<LogBlock> out;
+  for (const auto& r : sim::testing::executed_blocks(sim::testing::read_log(log)))
+    out.push_back({r["line"], r.value("completed", true)});
+  return out;
+}
+
+}  // namespace lamina::daemon::testing

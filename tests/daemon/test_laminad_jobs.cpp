@@ -1,0 +1,164 @@
+// laminad end to end against lamina-sim: a job submitted over the socket is planned, each sheet
+// confirmed as the operator would, streamed through the simulated CNC; the simulator's execution
+// log is the programs, line for line. Hold/resume, abort + resume, cancel while planning.
+#include <gtest/gtest.h>
+
+#include "daemon_fixture.hpp"
+
+namespace lamina::daemon::testing {
+namespace {
+
+const std::string kModel = std::string(LAMINA_EXAMPLES_DIR) + "/knob.stl";
+const std::string kRemnants = std::string(LAMINA_EXAMPLES_DIR) + "/remnants.toml";
+
+// Confirms sheets as they come until the job completes (or stops being runnable).
+Json run_to_completion(RpcClient& c, const std::string& id, double wait_s) {
+  const auto t0 = std::chrono::steady_clock::now();
+  Json j;
+  while (seconds_since(t0) < wait_s) {
+    j = wait_job(c, id, [](const Json& x) {
+      const std::string s = x["state"];
+      return s == "waiting_sheet" || s == "completed" || s == "failed" || s == "paused" || s == "cancelled";
+    }, wait_s);
+    if (j["state"] != "waiting_sheet") return j;
+    call_ok(c, "job.confirm_sheet", {{"job", id}, {"sheet", j["current_sheet"]}});
+  }
+  return j;
+}
+
+TEST(LaminadJobs, SubmittedModelIsPlannedAndEverySheetCutLineForLine) {
+  Cell cell({}, 50);
+  Laminad daemon(cell.config(), cell.dir.file(""));
+  RpcClient c = connect(cell.socket());
+  const Json info = call_ok(c, "server.info");
+  EXPECT_EQ(info["name"], "laminad");
+
+  Json job = call_ok(c, "job.submit", {{"model", kModel}, {"settings", {{"stock_file", kRemnants}, {"microjoints", 2}}}});
+  const std::string id = job["id"];
+  EXPECT_EQ(job["state"], "queued");
+  job = wait_state(c, id, "waiting_sheet", 120);
+  ASSERT_EQ(job["state"], "waiting_sheet") << job.dump(2) << daemon.log();
+  ASSERT_GE(job["sheets"].size(), 2u) << "the remnant rack needs several sheets";
+  EXPECT_EQ(job["current_sheet"], 1);
+  // Nothing moves before the operator confirms the sheet.
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  EXPECT_TRUE(executed(cell.log()).empty());
+  // The wrong sheet is refused.
+  auto wrong = c.call("job.confirm_sheet", {{"job", id}, {"sheet", 2}});
+  ASSERT_FALSE(wrong);
+  EXPECT_EQ(wrong.error().code, -32602);
+
+  job = run_to_completion(c, id, 300);
+  ASSERT_EQ(job["state"], "completed") << job.dump(2) << daemon.log();
+  std::vector<std::string> expected;
+  for (const Json& s : job["sheets"]) {
+    EXPECT_EQ(s["state"], "done");
+    const auto lines = program_lines(s["program"]);
+    EXPECT_EQ(s["lines"], lines.size());
+    expected.insert(expected.end(), lines.begin(), lines.end());
+  }
+  const auto log = executed(cell.log());
+  ASSERT_EQ(log.size(), expected.size());
+  for (std::size_t i = 0; i < log.size(); ++i) {
+    ASSERT_EQ(log[i].line, expected[i]) << "block " << i + 1;
+    ASSERT_TRUE(log[i].completed) << "block " << i + 1;
+  }
+  EXPECT_GT(job["summary"]["layers"].get<int>(), 0);
+  EXPECT_TRUE(std::filesystem::exists(job["summary"]["stack"].get<std::string>()));
+  // The cell is left safe: jet, abrasive and pump off.
+  const Json st = call_ok(c, "machine.status");
+  EXPECT_EQ(st["cell"]["jet_is_on"], false);
+}
+
+TEST(LaminadJobs, HoldThenResumeFinishesTheSheet) {
+  Cell cell({}, 10);
+  Laminad daemon(cell.config(), cell.dir.file(""));
+  RpcClient c = connect(cell.socket());
+  Json job = call_ok(c, "job.submit", {{"model", kModel}, {"settings", {{"stock", "5"}}}});
+  const std::string id = job["id"];
+  job = wait_state(c, id, "waiting_sheet", 120);
+  ASSERT_EQ(job["state"], "waiting_sheet") << daemon.log();
+  call_ok(c, "job.confirm_sheet", {{"job", id}, {"sheet", 1}});
+  ASSERT_TRUE(sim::testing::wait_status(cell.sim.control_port(), [](const Json& s) { return s["executed_blocks"] > 100; }, 60));
+  call_ok(c, "machine.hold");
+  job = call_ok(c, "job.get", {{"job", id}});
+  EXPECT_EQ(job["state"], "paused");
+  ASSERT_TRUE(sim::testing::wait_status(cell.sim.control_port(), [](const Json& s) { return s["state"] == "hold"; }, 10));
+  const auto held_at = executed(cell.log()).size();
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  EXPECT_EQ(executed(cell.log()).size(), held_at) << "nothing runs while held";
+  call_ok(c, "machine.resume");
+  job = run_to_completion(c, id, 300);
+  ASSERT_EQ(job["state"], "completed") << job.dump(2);
+  const auto lines = program_lines(job["sheets"][0]["program"]);
+  const auto log = executed(cell.log());
+  ASSERT_EQ(log.size(), lines.size());
+  for (std::size_t i = 0; i < log.size(); ++i) ASSERT_EQ(log[i].line, lines[i]);
+}
+
+TEST(LaminadJobs, AbortStopsSafelyAndJobResumeRestartsAtTheContour) {
+  Cell cell({}, 10);
+  Laminad daemon(cell.config(), cell.dir.file(""));
+  RpcClient c = connect(cell.socket());
+  Json job = call_ok(c, "job.submit", {{"model", kModel}, {"settings", {{"stock", "5"}}}});
+  const std::string id = job["id"];
+  ASSERT_EQ(wait_state(c, id, "waiting_sheet", 120)["state"], "waiting_sheet") << daemon.log();
+  call_ok(c, "job.confirm_sheet", {{"job", id}, {"sheet", 1}});
+  ASSERT_TRUE(sim::testing::wait_status(cell.sim.control_port(), [](const Json& s) { return s["executed_blocks"] > 300; }, 60));
+  call_ok(c, "machine.abort");
+  job = wait_state(c, id, "paused", 30);
+  ASSERT_EQ(job["state"], "paused") << job.dump(2);
+  EXPECT_FALSE(job["error"].get<std::string>().empty());
+  // Stopped means stopped: nothing runs and the jet is off until the operator says so.
+  const auto stopped_at = executed(cell.log()).size();
+  std::this_thread::sleep_for(std::chrono::milliseconds(700));
+  EXPECT_EQ(executed(cell.log()).size(), stopped_at);
+  EXPECT_EQ(call_ok(c, "machine.status")["cell"]["jet_is_on"], false);
+
+  call_ok(c, "job.resume", {{"job", id}});
+  job = run_to_completion(c, id, 300);
+  ASSERT_EQ(job["state"], "completed") << job.dump(2) << daemon.log();
+  // Every line ran; the resumed part starts at a contour marker inside the stopped contour.
+  const auto lines = program_lines(job["sheets"][0]["program"]);
+  const auto log = executed(cell.log());
+  std::size_t first_run_done = 0;
+  while (first_run_done < log.size() && first_run_done < lines.size() && log[first_run_done].line == lines[first_run_done] &&
+         log[first_run_done].completed)
+    ++first_run_done;
+  std::size_t restart = lines.size();
+  for (std::size_t i = first_run_done; i < log.size(); ++i)
+    if (log[i].line.rfind("(CONTOUR ", 0) == 0) {
+      for (std::size_t k = 0; k < lines.size(); ++k)
+        if (lines[k] == log[i].line) restart = k;
+      break;
+    }
+  ASSERT_LT(restart, lines.size()) << "no contour marker after the stop";
+  EXPECT_LE(restart, first_run_done) << "nothing after the stop was skipped";
+  std::size_t contour_of_stop = 0;
+  for (std::size_t k = 0; k <= std::min(first_run_done, lines.size() - 1); ++k)
+    if (lines[k].rfind("(CONTOUR ", 0) == 0) contour_of_stop = k;
+  EXPECT_EQ(restart, contour_of_stop) << "restart at the start of the contour being cut, not earlier";
+  EXPECT_EQ(log.back().line, lines.back());
+}
+
+TEST(LaminadJobs, CancelWhilePlanningStopsThePlanner) {
+  Cell cell;
+  Laminad daemon(cell.config(), cell.dir.file(""));
+  RpcClient c = connect(cell.socket());
+  // Fine sub-slices and sections: a plan that takes a while.
+  Json job = call_ok(c, "job.submit", {{"model", kModel}, {"settings", {{"sub_slice_mm", 0.02}, {"tolerance_mm", 0.01}}}});
+  const std::string id = job["id"];
+  ASSERT_EQ(wait_state(c, id, "planning", 30)["state"], "planning");
+  const auto t0 = std::chrono::steady_clock::now();
+  call_ok(c, "job.cancel", {{"job", id}});
+  job = wait_state(c, id, "cancelled", 10);
+  EXPECT_EQ(job["state"], "cancelled") << job.dump(2);
+  EXPECT_LT(seconds_since(t0), 5.0);
+  EXPECT_EQ(std::system("pgrep -f 'lamina plan .*knob.stl.*sub-slice 0.02' > /dev/null"), 256) << "the planner is gone";
+  // The daemon takes the next job as usual.
+  Json next = call_ok(c, "job.submit", {{"model", kModel}, {"settings", {{"stock", "5"}}}});
+  EXPECT_EQ(wait_state(c, next["id"], "waiting_sheet", 120)["state"], "waiting_sheet");
+}
+
+}  // namespace
+}  // namespace lamina::daemon::testing

@@ -1,0 +1,131 @@
+// A malformed or hostile client gets its error and the daemon keeps serving everyone else:
+// bad JSON, oversized lines, unknown methods, bad params, TCP without the token; 50 clients at
+// once while a job streams; sd_notify READY/STOPPING.
+#include <gtest/gtest.h>
+
+#include <sys/socket.h>
+#include <sys/un.h>
+
+#include <atomic>
+
+#include "daemon_fixture.hpp"
+
+namespace lamina::daemon::testing {
+namespace {
+
+// A raw line on a fresh connection; the first reply line (empty when the daemon closed it).
+std::string raw_exchange(const std::string& socket, const std::string& bytes) {
+  const int fd = ::socket(AF_UNIX, SOCK_STREAM, 0);
+  sockaddr_un addr{};
+  addr.sun_family = AF_UNIX;
+  std::snprintf(addr.sun_path, sizeof addr.sun_path, "%s", socket.c_str());
+  if (::connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0) return "connect failed";
+  std::size_t sent = 0;
+  while (sent < bytes.size()) {
+    const auto n = ::send(fd, bytes.data() + sent, bytes.size() - sent, MSG_NOSIGNAL);
+    if (n <= 0) break;
+    sent += static_cast<std::size_t>(n);
+  }
+  std::string reply;
+  char c;
+  pollfd p{fd, POLLIN, 0};
+  while (::poll(&p, 1, 5000) > 0 && ::read(fd, &c, 1) == 1 && c != '\n') reply += c;
+  ::close(fd);
+  return reply;
+}
+
+int error_code(const std::string& reply) {
+  const Json j = Json::parse(reply);
+  return j.at("error").at("code").get<int>();
+}
+
+TEST(LaminadProtocol, EveryBadRequestGetsItsErrorAndTheDaemonKeepsServing) {
+  Cell cell;
+  Laminad daemon(cell.config(), cell.dir.file(""));
+  RpcClient c = connect(cell.socket());
+  EXPECT_EQ(error_code(raw_exchange(cell.socket(), "{not json\n")), -32700);
+  EXPECT_EQ(error_code(raw_exchange(cell.socket(), "[1,2]\n")), -32600);
+  EXPECT_EQ(error_code(raw_exchange(cell.socket(), R"({"jsonrpc":"1.0","id":1,"method":"job.list"})" "\n")), -32600);
+  EXPECT_EQ(error_code(raw_exchange(cell.socket(), std::string(2 << 20, 'x') + "\n")), -32600);
+  auto unknown = c.call("job.explode");
+  ASSERT_FALSE(unknown);
+  EXPECT_EQ(unknown.error().code, -32601);
+  for (const Json& params : {Json::object(), Json{{"job", 5}}}) {
+    auto r = c.call("job.get", params);
+    ASSERT_FALSE(r);
+    EXPECT_EQ(r.error().code, -32602) << params;
+  }
+  auto relative = c.call("job.submit", {{"model", "knob.stl"}});
+  ASSERT_FALSE(relative);
+  EXPECT_EQ(relative.error().code, -32602);
+  auto bad_setting = c.call("job.submit", {{"model", std::string(LAMINA_EXAMPLES_DIR) + "/knob.stl"}, {"settings", {{"strategy", "wavy"}}}});
+  ASSERT_FALSE(bad_setting);
+  EXPECT_EQ(bad_setting.error().code, -32602);
+  EXPECT_NE(bad_setting.error().message.find("strategy"), std::string::npos) << bad_setting.error().message;
+  auto missing = c.call("job.get", {{"job", "j-0-0000"}});
+  ASSERT_FALSE(missing);
+  EXPECT_EQ(missing.error().code, -32010);
+  auto nothing = c.call("machine.hold");
+  ASSERT_FALSE(nothing);
+  EXPECT_EQ(nothing.error().code, -32011);
+  // Still serving, on the first connection and new ones.
+  EXPECT_TRUE(call_ok(c, "job.list").is_array());
+  RpcClient other = connect(cell.socket());
+  EXPECT_EQ(call_ok(other, "server.info")["name"], "laminad");
+  EXPECT_TRUE(daemon.running());
+}
+
+TEST(LaminadProtocol, TcpNeedsTheToken) {
+  Cell cell;
+  const int port = 20000 + (::getpid() % 20000);
+  Laminad daemon(cell.config(fmt::format("tcp = \"127.0.0.1:{}\"\ntoken = \"s3cret-token\"", port)), cell.dir.file(""));
+  (void)connect(cell.socket());  // up
+  auto no_token = RpcClient::connect_tcp("127.0.0.1", port, "");
+  ASSERT_TRUE(no_token) << no_token.error();
+  auto r = no_token->call("job.list");
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error().code, -32001);
+  auto wrong = RpcClient::connect_tcp("127.0.0.1", port, "guess");
+  ASSERT_TRUE(wrong);
+  r = wrong->call("job.list");
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error().code, -32001);
+  auto right = RpcClient::connect_tcp("127.0.0.1", port, "s3cret-token");
+  ASSERT_TRUE(right);
+  EXPECT_TRUE(right->call("job.list"));
+}
+
+TEST(LaminadProtocol, FiftyClientsWhileAJobStreamsAreAllAnswered) {
+  Cell cell({}, 10);
+  Laminad daemon(cell.config(), cell.dir.file(""));
+  RpcClient c = connect(cell.socket());
+  Json job = call_ok(c, "job.submit", {{"model", std::string(LAMINA_EXAMPLES_DIR) + "/knob.stl"}, {"settings", {{"stock", "5"}}}});
+  const std::string id = job["id"];
+  ASSERT_EQ(wait_state(c, id, "waiting_sheet", 120)["state"], "waiting_sheet");
+  call_ok(c, "job.confirm_sheet", {{"job", id}, {"sheet", 1}});
+  ASSERT_TRUE(sim::testing::wait_status(cell.sim.control_port(), [](const Json& s) { return s["executed_blocks"] > 50; }, 60));
+  std::atomic<int> ok{0}, bad{0};
+  std::vector<std::thread> clients;
+  for (int i = 0; i < 50; ++i)
+    clients.emplace_back([&, i] {
+      auto cl = RpcClient::connect_unix(cell.socket());
+      if (!cl) {
+        ++bad;
+        return;
+      }
+      for (int k = 0; k < 20; ++k) {
+        auto r = cl->call(k % 2 ? "job.list" : "machine.status", Json::object(), 10);
+        (r && (k % 2 ? r->is_array() : r->contains("state"))) ? ++ok : ++bad;
+      }
+      (void)i;
+    });
+  for (auto& t : clients) t.join();
+  EXPECT_EQ(ok.load(), 1000);
+  EXPECT_EQ(bad.load(), 0);
+  const Json st = sim::testing::control_status(cell.sim.control_port());
+  EXPECT_EQ(st["starvation"], 0) << "the daemon kept the CNC fed while serving: " << st.dump();
+  call_ok(c, "job.cancel", {{"job", id}});
+}
+
+}  // namespace
+}  // namespace lamina::daemon::testing
