@@ -55,7 +55,7 @@ struct DaemonConfig {
 };
 
 struct ConfigError {
-  std::string message;  // "<file>: [section] key: what is wrong"
+  std::string message;  // "<file>:<line>: [section] key: what is wrong"
 };
 
 std::expected<DaemonConfig, ConfigError> load_daemon_config(const std::filesystem::path& file);

@@ -1,0 +1,301 @@
+// laminad's configuration: the shipped files parse to what they say, and every mistake a person
+// can make in the file is an error naming the key and its line.
+#include "lamina/daemon/daemon_config.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+namespace {
+
+namespace fs = std::filesystem;
+using lamina::daemon::DaemonConfig;
+using lamina::daemon::load_daemon_config;
+using lamina::daemon::parse_daemon_config;
+
+const fs::path kSource = LAMINA_SOURCE_DIR;
+
+// A fresh folder per test (removed with its files at the end).
+class ScratchDir {
+ public:
+  ScratchDir() {
+    std::string pattern = (fs::temp_directory_path() / "lamina-config-XXXXXX").string();
+    if (!mkdtemp(pattern.data())) throw std::runtime_error("mkdtemp failed");
+    path_ = pattern;
+  }
+  ~ScratchDir() {
+    std::error_code ec;
+    fs::remove_all(path_, ec);
+  }
+  const fs::path& path() const { return path_; }
+  fs::path write(const std::string& name, const std::string& text) const {
+    const fs::path file = path_ / name;
+    fs::create_directories(file.parent_path());
+    std::ofstream(file) << text;
+    return file;
+  }
+
+ private:
+  fs::path path_;
+};
+
+// The message of a configuration that must be refused.
+std::string error_of(const std::string& text) {
+  auto c = parse_daemon_config(text, "test.toml");
+  EXPECT_FALSE(c.has_value()) << "accepted:\n" << text;
+  return c ? std::string{} : c.error().message;
+}
+
+// Every field, so that a default changed in the header but not in config/lamina.toml is caught.
+void expect_same(const DaemonConfig& a, const DaemonConfig& b) {
+  EXPECT_EQ(a.state_dir, b.state_dir);
+  EXPECT_EQ(a.server.socket_path, b.server.socket_path);
+  EXPECT_EQ(a.server.socket_mode, b.server.socket_mode);
+  EXPECT_EQ(a.server.socket_group, b.server.socket_group);
+  EXPECT_EQ(a.server.tcp_host, b.server.tcp_host);
+  EXPECT_EQ(a.server.tcp_port, b.server.tcp_port);
+  EXPECT_EQ(a.server.token, b.server.token);
+  EXPECT_EQ(a.server.max_request_bytes, b.server.max_request_bytes);
+  EXPECT_EQ(a.link.protocol, b.link.protocol);
+  EXPECT_EQ(a.link.port, b.link.port);
+  EXPECT_EQ(a.link.tcp, b.link.tcp);
+  EXPECT_EQ(a.link.baud, b.link.baud);
+  EXPECT_EQ(a.link.rx_buffer, b.link.rx_buffer);
+  EXPECT_EQ(a.link.status_hz, b.link.status_hz);
+  EXPECT_EQ(a.cell.enabled, b.cell.enabled);
+  EXPECT_EQ(a.cell.modbus, b.cell.modbus);
+  EXPECT_EQ(a.cell.heartbeat_period_s, b.cell.heartbeat_period_s);
+  EXPECT_EQ(a.cell.pump_ready_timeout_s, b.cell.pump_ready_timeout_s);
+  EXPECT_EQ(a.cell.pressure_setpoint_mpa, b.cell.pressure_setpoint_mpa);
+  EXPECT_EQ(a.cell.abrasive_g_per_min, b.cell.abrasive_g_per_min);
+  EXPECT_EQ(a.planner.lamina_path, b.planner.lamina_path);
+  EXPECT_EQ(a.planner.workers, b.planner.workers);
+  EXPECT_EQ(a.planner.machine_file, b.planner.machine_file);
+  EXPECT_EQ(a.planner.materials_file, b.planner.materials_file);
+  EXPECT_EQ(a.planner.timeout_s, b.planner.timeout_s);
+}
+
+TEST(DaemonConfig, TheDefaultsFileHoldsTheStructDefaults) {
+  const fs::path file = kSource / "config/lamina.toml";
+  auto c = load_daemon_config(file);
+  ASSERT_TRUE(c.has_value()) << c.error().message;
+  expect_same(*c, DaemonConfig{});
+  EXPECT_EQ(c->source, file.string());
+}
+
+TEST(DaemonConfig, TheDefaultsFileShowsEveryKey) {
+  // "Every key is shown": a key added to the parser must be added to the shipped file too.
+  std::ifstream in(kSource / "config/lamina.toml");
+  std::string text((std::istreambuf_iterator<char>(in)), {});
+  for (const char* key : {"state_dir", "socket", "socket_mode", "socket_group", "tcp", "token", "token_file",
+                          "max_request_bytes", "protocol", "port", "baud", "rx_buffer", "status_hz", "enabled",
+                          "modbus", "heartbeat_period_s", "pump_ready_timeout_s", "pressure_setpoint_mpa",
+                          "abrasive_g_per_min", "lamina", "workers", "machine", "materials", "timeout_s"})
+    EXPECT_NE(text.find(std::string("\n") + key + " = "), std::string::npos) << key;
+}
+
+TEST(DaemonConfig, TheDemoFilePointsAtTheSimulator) {
+  auto c = load_daemon_config(kSource / "config/demo.toml");
+  ASSERT_TRUE(c.has_value()) << c.error().message;
+  EXPECT_EQ(c->state_dir, "/tmp/lamina-demo/state");
+  EXPECT_EQ(c->server.socket_path, "/tmp/lamina-demo/lamina.sock");
+  EXPECT_EQ(c->server.socket_group, "");
+  EXPECT_FALSE(c->server.tcp_host);
+  EXPECT_EQ(c->link.protocol, "grbl");
+  EXPECT_EQ(c->link.port, "/tmp/lamina-demo/cnc");
+  EXPECT_EQ(c->link.tcp, "");
+  EXPECT_TRUE(c->cell.enabled);
+  EXPECT_EQ(c->cell.modbus, "127.0.0.1:1502");
+}
+
+TEST(DaemonConfig, AnEmptyFileKeepsTheDefaults) {
+  auto c = parse_daemon_config("", "empty.toml");
+  ASSERT_TRUE(c.has_value()) << c.error().message;
+  expect_same(*c, DaemonConfig{});
+}
+
+TEST(DaemonConfig, UnknownKeysAndSectionsAreErrorsAtTheirLine) {
+  const std::string key = error_of("[server]\nsocket = \"/run/x.sock\"\nsockt_mode = \"0660\"\n");
+  EXPECT_NE(key.find("test.toml:3: [server] sockt_mode: unknown key (known: socket, socket_mode,"), std::string::npos)
+      << key;
+  const std::string section = error_of("state_dir = \"/x\"\n\n[srever]\nsocket = \"/y\"\n");
+  EXPECT_NE(section.find("test.toml:3: [srever]: unknown section"), std::string::npos) << section;
+  const std::string top = error_of("# a comment\nstatedir = \"/x\"\n");
+  EXPECT_NE(top.find("test.toml:2: statedir: unknown key"), std::string::npos) << top;
+  const std::string cell = error_of("[cell]\nenabled = true\npressure_mpa = 380\n");
+  EXPECT_NE(cell.find("test.toml:3: [cell] pressure_mpa: unknown key (known: enabled, modbus,"), std::string::npos) << cell;
+}
+
+TEST(DaemonConfig, WrongTypesAreErrorsAtTheirLine) {
+  const std::string baud = error_of("[link]\nport = \"/dev/ttyUSB0\"\nbaud = \"fast\"\n");
+  EXPECT_NE(baud.find("test.toml:3: [link] baud: expected a whole number"), std::string::npos) << baud;
+  const std::string enabled = error_of("[cell]\nenabled = \"yes\"\n");
+  EXPECT_NE(enabled.find("test.toml:2: [cell] enabled: expected true or false"), std::string::npos) << enabled;
+  const std::string workers = error_of("[planner]\n\nworkers = 1.5\n");
+  EXPECT_NE(workers.find("test.toml:3: [planner] workers:"), std::string::npos) << workers;
+  const std::string server = error_of("server = 1\n");
+  EXPECT_NE(server.find("test.toml:1: server: expected a table"), std::string::npos) << server;
+  const std::string socket = error_of("[server]\nsocket = 7\n");
+  EXPECT_NE(socket.find("test.toml:2: [server] socket: expected a string"), std::string::npos) << socket;
+}
+
+TEST(DaemonConfig, ValuesOutOfRangeAreErrors) {
+  EXPECT_NE(error_of("[link]\nstatus_hz = 0\n").find("test.toml:2: [link] status_hz: 0 is out of range [0.5, 50]"),
+            std::string::npos);
+  EXPECT_NE(error_of("[link]\nbaud = 100\n").find("[link] baud: 100 is out of range"), std::string::npos);
+  EXPECT_NE(error_of("[cell]\npump_ready_timeout_s = 0\n").find("[cell] pump_ready_timeout_s: 0 is out of range (0,"),
+            std::string::npos);
+  EXPECT_NE(error_of("[cell]\npressure_setpoint_mpa = 6200\n").find("[cell] pressure_setpoint_mpa"), std::string::npos);
+  EXPECT_NE(error_of("[planner]\nworkers = 0\n").find("[planner] workers: 0 is out of range [1, 64]"), std::string::npos);
+  EXPECT_NE(error_of("[server]\nmax_request_bytes = -1\n").find("[server] max_request_bytes"), std::string::npos);
+  EXPECT_NE(error_of("state_dir = \"\"\n").find("test.toml:1: state_dir: must not be empty"), std::string::npos);
+  EXPECT_NE(error_of("[server]\nsocket = \"/" + std::string(120, 's') + "\"\n").find("[server] socket:"),
+            std::string::npos);
+  // Edges that are allowed.
+  auto c = parse_daemon_config("[link]\nstatus_hz = 50\nbaud = 4000000\n[cell]\nabrasive_g_per_min = 0\n", "t.toml");
+  ASSERT_TRUE(c.has_value()) << c.error().message;
+  EXPECT_EQ(c->link.status_hz, 50);
+  EXPECT_EQ(c->cell.abrasive_g_per_min, 0);
+}
+
+TEST(DaemonConfig, SocketModeIsAnOctalString) {
+  const std::string expected = "test.toml:3: [server] socket_mode: expected an octal string like \"0660\"";
+  EXPECT_EQ(error_of("[server]\nsocket = \"/run/x.sock\"\nsocket_mode = 660\n"), expected);
+  EXPECT_EQ(error_of("[server]\nsocket = \"/run/x.sock\"\nsocket_mode = \"0968\"\n"), expected);
+  EXPECT_EQ(error_of("[server]\nsocket = \"/run/x.sock\"\nsocket_mode = \"4660\"\n"), expected);
+  EXPECT_EQ(error_of("[server]\nsocket = \"/run/x.sock\"\nsocket_mode = \"rw-rw----\"\n"), expected);
+  for (const auto& [text, mode] : {std::pair{"0600", 0600u}, std::pair{"660", 0660u}, std::pair{"0777", 0777u}}) {
+    auto c = parse_daemon_config(std::string("[server]\nsocket_mode = \"") + text + "\"\n", "t.toml");
+    ASSERT_TRUE(c.has_value()) << c.error().message;
+    EXPECT_EQ(c->server.socket_mode, mode) << text;
+  }
+}
+
+TEST(DaemonConfig, TcpNeedsAToken) {
+  const std::string e = error_of("[server]\ntcp = \"127.0.0.1:7400\"\n");
+  EXPECT_NE(e.find("test.toml:2: [server] tcp: TCP needs a token"), std::string::npos) << e;
+  EXPECT_NE(error_of("[server]\ntcp = \"7400\"\ntoken = \"s3cret\"\n").find("test.toml:2: [server] tcp: expected \"HOST:PORT\""),
+            std::string::npos);
+  EXPECT_NE(error_of("[server]\ntcp = \"host:70000\"\ntoken = \"s3cret\"\n").find("[server] tcp:"), std::string::npos);
+
+  auto c = parse_daemon_config("[server]\ntcp = \"0.0.0.0:7400\"\ntoken = \"s3cret\"\n", "t.toml");
+  ASSERT_TRUE(c.has_value()) << c.error().message;
+  EXPECT_EQ(c->server.tcp_host, "0.0.0.0");
+  EXPECT_EQ(c->server.tcp_port, 7400);
+  EXPECT_EQ(c->server.token, "s3cret");
+  auto v6 = parse_daemon_config("[server]\ntcp = \"[::1]:7401\"\ntoken = \"s3cret\"\n", "t.toml");
+  ASSERT_TRUE(v6.has_value()) << v6.error().message;
+  EXPECT_EQ(v6->server.tcp_host, "::1");
+  EXPECT_EQ(v6->server.tcp_port, 7401);
+}
+
+TEST(DaemonConfig, TheTokenComesFromTheTokenFile) {
+  ScratchDir dir;
+  dir.write("etc/token", "  t0ken-from-file\n");
+  dir.write("etc/empty-token", "\n\n");
+  const auto file = dir.write("etc/lamina.toml", "[server]\ntcp = \"127.0.0.1:7400\"\ntoken_file = \"token\"\n");
+  auto c = load_daemon_config(file);
+  ASSERT_TRUE(c.has_value()) << c.error().message;
+  EXPECT_EQ(c->server.token, "t0ken-from-file");
+
+  const auto missing = dir.write("etc/missing.toml", "[server]\n\ntoken_file = \"no-such-token\"\n");
+  auto m = load_daemon_config(missing);
+  ASSERT_FALSE(m.has_value());
+  EXPECT_NE(m.error().message.find(missing.string() + ":3: [server] token_file: cannot read " +
+                                   (dir.path() / "etc/no-such-token").string()),
+            std::string::npos)
+      << m.error().message;
+
+  auto empty = load_daemon_config(dir.write("etc/e.toml", "[server]\ntoken_file = \"empty-token\"\n"));
+  ASSERT_FALSE(empty.has_value());
+  EXPECT_NE(empty.error().message.find(":2: [server] token_file:"), std::string::npos) << empty.error().message;
+  EXPECT_NE(empty.error().message.find("is empty"), std::string::npos) << empty.error().message;
+
+  auto both = load_daemon_config(dir.write("etc/b.toml", "[server]\ntoken = \"x\"\ntoken_file = \"token\"\n"));
+  ASSERT_FALSE(both.has_value());
+  EXPECT_NE(both.error().message.find("token or token_file, not both"), std::string::npos) << both.error().message;
+}
+
+TEST(DaemonConfig, ProtocolMustBeKnown) {
+  const std::string e = error_of("[link]\nprotocol = \"marlin\"\n");
+  EXPECT_NE(e.find("test.toml:2: [link] protocol: \"marlin\" is not one of grbl, send-response, xonxoff, modbus"),
+            std::string::npos)
+      << e;
+  for (const char* p : {"grbl", "send-response", "xonxoff"}) {
+    auto c = parse_daemon_config(std::string("[link]\nprotocol = \"") + p + "\"\n", "t.toml");
+    ASSERT_TRUE(c.has_value()) << p << ": " << c.error().message;
+    EXPECT_EQ(c->link.protocol, p);
+  }
+}
+
+TEST(DaemonConfig, TheLinkIsReachedOneWay) {
+  const std::string both = error_of("[link]\nport = \"/dev/ttyUSB0\"\ntcp = \"10.0.0.5:23\"\n");
+  EXPECT_NE(both.find("test.toml:3: [link] tcp: give port (serial) or tcp"), std::string::npos) << both;
+  // The Modbus mailbox goes through the PLC at [cell] modbus: port/tcp would be ignored.
+  const std::string mailbox_port = error_of("[link]\nprotocol = \"modbus\"\nport = \"/dev/ttyUSB0\"\n");
+  EXPECT_NE(mailbox_port.find("test.toml:3: [link] port: protocol \"modbus\""), std::string::npos) << mailbox_port;
+  const std::string no_cell = error_of("[link]\nprotocol = \"modbus\"\n[cell]\nenabled = false\n");
+  EXPECT_NE(no_cell.find("test.toml:2: [link] protocol:"), std::string::npos) << no_cell;
+  auto ok = parse_daemon_config("[link]\nprotocol = \"modbus\"\n[cell]\nmodbus = \"10.0.0.9:502\"\n", "t.toml");
+  ASSERT_TRUE(ok.has_value()) << ok.error().message;
+  EXPECT_EQ(ok->cell.modbus, "10.0.0.9:502");
+  auto tcp = parse_daemon_config("[link]\ntcp = \"10.0.0.5:23\"\n", "t.toml");
+  ASSERT_TRUE(tcp.has_value()) << tcp.error().message;
+  EXPECT_EQ(tcp->link.tcp, "10.0.0.5:23");
+}
+
+TEST(DaemonConfig, TheCellNeedsItsPlcAddressWhenEnabled) {
+  EXPECT_NE(error_of("[cell]\nmodbus = \"\"\n").find("test.toml:2: [cell] modbus:"), std::string::npos);
+  EXPECT_NE(error_of("[cell]\nmodbus = \"plc\"\n").find("test.toml:2: [cell] modbus: expected \"HOST:PORT\""),
+            std::string::npos);
+  auto off = parse_daemon_config("[cell]\nenabled = false\nmodbus = \"\"\n", "t.toml");
+  ASSERT_TRUE(off.has_value()) << off.error().message;
+  EXPECT_FALSE(off->cell.enabled);
+}
+
+TEST(DaemonConfig, RelativePathsStartAtTheFilesFolder) {
+  ScratchDir dir;
+  dir.write("cfg/token", "abc\n");
+  const auto file = dir.write("cfg/lamina.toml",
+                              "state_dir = \"state\"\n[server]\nsocket = \"run/l.sock\"\ntoken_file = \"token\"\n"
+                              "[planner]\nlamina = \"../bin/lamina\"\nmachine = \"machine.toml\"\n"
+                              "materials = \"/abs/materials.toml\"\n");
+  auto c = load_daemon_config(file);
+  ASSERT_TRUE(c.has_value()) << c.error().message;
+  EXPECT_EQ(c->state_dir, dir.path() / "cfg/state");
+  EXPECT_EQ(c->server.socket_path, (dir.path() / "cfg/run/l.sock").string());
+  EXPECT_EQ(c->server.token, "abc");
+  EXPECT_EQ(c->planner.lamina_path, (dir.path() / "bin/lamina").string());
+  EXPECT_EQ(c->planner.machine_file, (dir.path() / "cfg/machine.toml").string());
+  EXPECT_EQ(c->planner.materials_file, "/abs/materials.toml");
+  // Parsed from text: relative to the folder of the name given.
+  auto t = parse_daemon_config("state_dir = \"state\"\n", "/etc/lamina/lamina.toml");
+  ASSERT_TRUE(t.has_value()) << t.error().message;
+  EXPECT_EQ(t->state_dir, "/etc/lamina/state");
+}
+
+TEST(DaemonConfig, OfSeveralMistakesTheFirstInTheFileIsReported) {
+  // toml++ walks keys alphabetically; a person reads top down.
+  EXPECT_EQ(error_of("x = 1\n[foo]\n").rfind("test.toml:1: x: unknown key", 0), 0u);
+  EXPECT_EQ(error_of("[link]\nbaud = 1\n[cell]\nmodbus = \"x\"\n[server]\nsockt = 1\n").rfind("test.toml:2: [link] baud", 0), 0u);
+  EXPECT_EQ(error_of("[server]\nsockt = 1\n[link]\nbaud = 1\n").rfind("test.toml:2: [server] sockt", 0), 0u);
+  // A token file that cannot be read is the mistake, not the TCP listener left without a token.
+  const std::string token = error_of("[server]\ntcp = \"127.0.0.1:7400\"\ntoken_file = \"/nonexistent/token\"\n");
+  EXPECT_EQ(token.rfind("test.toml:3: [server] token_file: cannot read /nonexistent/token", 0), 0u) << token;
+}
+
+TEST(DaemonConfig, SyntaxErrorsAndMissingFilesAreErrors) {
+  const std::string e = error_of("[server]\nsocket = \"/run/x.sock\n");
+  EXPECT_EQ(e.rfind("test.toml:2: ", 0), 0u) << e;
+  const std::string mode = error_of("[server]\nsocket_mode = 0660\n");
+  EXPECT_EQ(mode.rfind("test.toml:2: ", 0), 0u) << mode;
+  EXPECT_NE(mode.find("\"0660\""), std::string::npos) << mode;
+  auto missing = load_daemon_config("/nonexistent/lamina.toml");
+  ASSERT_FALSE(missing.has_value());
+  EXPECT_NE(missing.error().message.find("/nonexistent/lamina.toml"), std::string::npos) << missing.error().message;
+}
+
+}  // namespace
