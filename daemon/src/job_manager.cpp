@@ -73,6 +73,9 @@ std::expected<void, RpcError> JobManager::start() {
   std::lock_guard lock(mutex_);
   for (JobRecord& job : *all) {
     if (job.state == JobState::queued) plan_queue_.push_back(job.id);
+    // The sheet on the table belongs to the job that was waiting for it or was cutting it when
+    // the daemon stopped: that job keeps the machine until it is resumed or cancelled.
+    if (job.state == JobState::waiting_sheet || job.state == JobState::interrupted) machine_job_ = job.id;
     jobs_[job.id] = std::move(job);
   }
   const int workers = std::max(1, config_.planner.workers);
@@ -417,7 +420,8 @@ void JobManager::plan_job(const std::string& id) {
     return;
   }
   nlohmann::json deviation = nlohmann::json::object();
-  for (const auto& [strategy, d] : r.value("deviation", nlohmann::json::object()).items())
+  const nlohmann::json deviations = r.value("deviation", nlohmann::json::object());  // named: items() keeps a reference
+  for (const auto& [strategy, d] : deviations.items())
     deviation[strategy] = {{"volume_pct", d.value("volume_pct", 0.0)}, {"max_mm", d.value("max_mm", 0.0)}};
   job->summary = {{"layers", r.contains("layers") ? r["layers"].size() : 0},
                   {"sheets", job->sheets.size()},

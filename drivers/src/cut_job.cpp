@@ -36,6 +36,10 @@ CutJob::CutJob(MachineLink& link, CellIo* cell, std::vector<std::string> program
   report_.lines_total = program_.size();
 }
 
+CutJob::~CutJob() {
+  if (cell_) cell_->on_fault(nullptr);
+}
+
 CutReport CutJob::report() const {
   std::lock_guard lock(mutex_);
   return report_;

@@ -141,6 +141,8 @@ struct ModbusBlockLink::Impl {
       stop_requested = false;
       stop_reason.reset();
       on_done = callbacks.on_done;
+      // The job that gave these is over: its owner may be gone before the next status report.
+      callbacks = {};
     }
     if (result.error) log->error("streaming stopped: {}", result.error->message);
     if (on_done) on_done(result);

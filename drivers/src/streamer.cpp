@@ -7,6 +7,7 @@
 #include <deque>
 #include <mutex>
 #include <thread>
+#include <utility>
 
 #include <boost/asio/executor_work_guard.hpp>
 #include <boost/asio/io_context.hpp>
@@ -158,12 +159,23 @@ struct Streamer::Impl {
     o.last_accepted_index = accepted ? first_index + accepted - 1 : first_index;
     o.lines_accepted = accepted;
     publish_progress();
+    // The last word to this job's owner, then forget it: the owner may be destroyed as soon as
+    // wait() returns, and status reports keep coming between jobs.
+    LinkCallbacks cbs = std::exchange(callbacks, LinkCallbacks{});
+    if (cbs.on_progress) {
+      LinkProgress p;
+      {
+        std::lock_guard lock(mutex);
+        p = shared_progress;
+      }
+      cbs.on_progress(p);
+    }
     {
       std::lock_guard lock(mutex);
       outcome = o;
     }
     done_cv.notify_all();
-    if (callbacks.on_done) callbacks.on_done(o);
+    if (cbs.on_done) cbs.on_done(o);
   }
 
   void read_more() {

@@ -37,7 +37,8 @@ struct Cell {
       : sim([&] {
           std::vector<std::string> args{"--link", dir.file("cnc"), "--modbus", "127.0.0.1:0", "--control", "127.0.0.1:0",
                                         "--log", dir.file("exec.jsonl"), "--pressure-ramp", "0.2", "--baud", "921600",
-                                        "--time-scale", fmt::format("{}", time_scale), "--heartbeat-timeout", "1000"};
+                                        "--time-scale", fmt::format("{}", time_scale), "--heartbeat-timeout", "1000",
+                                        "--machine", std::string(LAMINA_SOURCE_DIR) + "/config/sim-machine.toml"};
           args.insert(args.end(), extra.begin(), extra.end());
           return args;
         }()) {}

@@ -53,6 +53,9 @@ class CutJob {
  public:
   // `cell` may be null (no PLC: dry runs, tests of the link alone).
   CutJob(MachineLink& link, CellIo* cell, std::vector<std::string> program, CutJobSettings settings = {});
+  ~CutJob();  // unhooks its fault handler from the cell (the cell outlives jobs)
+  CutJob(const CutJob&) = delete;
+  CutJob& operator=(const CutJob&) = delete;
 
   // Blocking: the whole program, or until it stops. Then report().state is completed or stopped
   // (or failed when the cell could not be brought up).
