@@ -1,0 +1,91 @@
+#pragma once
+// One client of rpc_server: reads newline-delimited requests, runs the handler, queues replies.
+// Used by rpc_server.cpp only; the server owns connections through shared_ptr and every
+// completion handler holds one too, so a connection outlives any operation still in flight.
+#include <cstddef>
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <boost/asio/buffer.hpp>
+#include <boost/asio/generic/stream_protocol.hpp>
+#include <boost/asio/steady_timer.hpp>
+#include <spdlog/logger.h>
+
+#include "lamina/daemon/rpc_server.hpp"
+
+namespace lamina::daemon::rpc_detail {
+
+// What the server and all its connections share. Connections keep it alive by shared_ptr, so it
+// outlives the RpcServer object when completion handlers are still queued in the io_context.
+struct ServerShared {
+  RpcServerSettings settings;
+  RpcServer::Handler handler;  // emptied when the RpcServer is destroyed: never called after that
+  std::shared_ptr<spdlog::logger> log;
+  // Every completion handler of the server and of its connections runs holding this lock, and so
+  // do stop() and the destructor. That is what lets those two close sockets synchronously from any
+  // thread, including when the io_context is not running. Uncontended in normal operation (one io
+  // thread); recursive because a handler may call stop().
+  std::recursive_mutex mutex;
+};
+
+class Connection : public std::enable_shared_from_this<Connection> {
+ public:
+  // Unix and TCP clients share one socket type: the code below does not care which it is.
+  using Socket = boost::asio::generic::stream_protocol::socket;
+  using ClosedCallback = std::function<void(std::uint64_t client_id)>;
+
+  Connection(Socket socket, ClientContext context, std::string peer, std::shared_ptr<ServerShared> shared,
+             ClosedCallback on_closed);
+  Connection(const Connection&) = delete;
+  Connection& operator=(const Connection&) = delete;
+
+  // All of these must be called holding shared->mutex.
+  void start();
+  // Queues a complete line; a client whose queue passes max_queued_bytes is dropped instead.
+  void send(std::shared_ptr<const std::string> line);
+  // Idempotent. Queued replies are discarded; on_closed runs once.
+  void close(std::string_view reason);
+  const ClientContext& context() const { return context_; }
+
+ private:
+  void read_next();
+  void on_read(const boost::system::error_code& error, std::size_t size);
+  void handle_line(std::string_view line);
+  RpcResult invoke(const RpcRequest& request);
+  void send_line(std::string line);
+  void refuse_oversize(std::size_t bytes);
+  void write_next();
+  void on_write(const boost::system::error_code& error);
+
+  Socket socket_;
+  ClientContext context_;
+  std::string peer_;  // for the log: "unix pid 123 uid 1000" or "tcp 127.0.0.1:51234"
+  std::shared_ptr<ServerShared> shared_;
+  ClosedCallback on_closed_;
+
+  std::vector<char> chunk_;  // one read's worth
+  std::string partial_;      // the start of a line whose '\n' has not arrived yet
+
+  std::deque<std::shared_ptr<const std::string>> queue_;  // broadcasts share one string
+  std::vector<std::shared_ptr<const std::string>> in_flight_;
+  std::vector<boost::asio::const_buffer> buffers_;  // into in_flight_, for one gathered write
+  std::size_t queued_bytes_ = 0;                    // queue_ and in_flight_ together
+  bool writing_ = false;
+
+  // After an oversize line: the error is written, input is read and discarded (closing with
+  // unread input would make TCP send a reset that can destroy the reply before the client reads
+  // it), and the connection closes on the client's EOF or when linger_ expires.
+  bool draining_ = false;
+  bool peer_done_ = false;  // the client half-closed: close once its replies are written
+  std::optional<boost::asio::steady_timer> linger_;
+  bool closed_ = false;
+};
+
+}  // namespace lamina::daemon::rpc_detail
