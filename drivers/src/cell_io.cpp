@@ -280,6 +280,7 @@ struct CellIo::Impl {
     for (int coil : {pm::kCoilJetOn, pm::kCoilAbrasiveEnable, pm::kCoilPumpEnable})
       if (auto r = client.write_bit(coil, false); !r && first) first = std::unexpected(r.error());
     if (first) log->info("cut finished: jet, abrasive and pump off");
+    (void)read_inputs();  // status() shows the cell as left, not as it was while cutting
     return first;
   }
 

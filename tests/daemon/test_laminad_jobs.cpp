@@ -71,7 +71,7 @@ TEST(LaminadJobs, SubmittedModelIsPlannedAndEverySheetCutLineForLine) {
 }
 
 TEST(LaminadJobs, HoldThenResumeFinishesTheSheet) {
-  Cell cell({}, 10);
+  Cell cell({}, 40);
   Laminad daemon(cell.config(), cell.dir.file(""));
   RpcClient c = connect(cell.socket());
   Json job = call_ok(c, "job.submit", {{"model", kModel}, {"settings", {{"stock", "5"}}}});
@@ -97,7 +97,7 @@ TEST(LaminadJobs, HoldThenResumeFinishesTheSheet) {
 }
 
 TEST(LaminadJobs, AbortStopsSafelyAndJobResumeRestartsAtTheContour) {
-  Cell cell({}, 10);
+  Cell cell({}, 40);
   Laminad daemon(cell.config(), cell.dir.file(""));
   RpcClient c = connect(cell.socket());
   Json job = call_ok(c, "job.submit", {{"model", kModel}, {"settings", {{"stock", "5"}}}});
@@ -154,7 +154,8 @@ TEST(LaminadJobs, CancelWhilePlanningStopsThePlanner) {
   job = wait_state(c, id, "cancelled", 10);
   EXPECT_EQ(job["state"], "cancelled") << job.dump(2);
   EXPECT_LT(seconds_since(t0), 5.0);
-  EXPECT_EQ(std::system("pgrep -f 'lamina plan .*knob.stl.*sub-slice 0.02' > /dev/null"), 256) << "the planner is gone";
+  // ([l]: the pattern must not match pgrep's own shell)
+  EXPECT_EQ(std::system("pgrep -f '[l]amina plan .*knob.stl.*sub-slice 0.02' > /dev/null"), 256) << "the planner is gone";
   // The daemon takes the next job as usual.
   Json next = call_ok(c, "job.submit", {{"model", kModel}, {"settings", {{"stock", "5"}}}});
   EXPECT_EQ(wait_state(c, next["id"], "waiting_sheet", 120)["state"], "waiting_sheet");

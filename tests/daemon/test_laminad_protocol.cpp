@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <sys/socket.h>
+#include <arpa/inet.h>
+#include <netinet/in.h>
 #include <sys/un.h>
 
 #include <atomic>
@@ -80,14 +82,24 @@ TEST(LaminadProtocol, TcpNeedsTheToken) {
   const int port = 20000 + (::getpid() % 20000);
   Laminad daemon(cell.config(fmt::format("tcp = \"127.0.0.1:{}\"\ntoken = \"s3cret-token\"", port)), cell.dir.file(""));
   (void)connect(cell.socket());  // up
-  auto no_token = RpcClient::connect_tcp("127.0.0.1", port, "");
-  ASSERT_TRUE(no_token) << no_token.error();
-  auto r = no_token->call("job.list");
-  ASSERT_FALSE(r);
-  EXPECT_EQ(r.error().code, -32001);
+  // Without a token (our client refuses to send none: a raw socket does).
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_port = htons(static_cast<std::uint16_t>(port));
+  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  ASSERT_EQ(::connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr), 0);
+  const std::string request = R"({"jsonrpc":"2.0","id":1,"method":"job.list","params":{}})" "\n";
+  ASSERT_EQ(::send(fd, request.data(), request.size(), MSG_NOSIGNAL), static_cast<ssize_t>(request.size()));
+  std::string reply;
+  char ch;
+  pollfd p{fd, POLLIN, 0};
+  while (::poll(&p, 1, 5000) > 0 && ::read(fd, &ch, 1) == 1 && ch != '\n') reply += ch;
+  ::close(fd);
+  EXPECT_EQ(error_code(reply), -32001) << reply;
   auto wrong = RpcClient::connect_tcp("127.0.0.1", port, "guess");
   ASSERT_TRUE(wrong);
-  r = wrong->call("job.list");
+  auto r = wrong->call("job.list");
   ASSERT_FALSE(r);
   EXPECT_EQ(r.error().code, -32001);
   auto right = RpcClient::connect_tcp("127.0.0.1", port, "s3cret-token");
