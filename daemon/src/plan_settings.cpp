@@ -74,6 +74,8 @@ std::expected<std::string, std::string> value_text(const Setting& s, const nlohm
       std::string text;
       if (v.is_string()) {
         text = v.get<std::string>();
+      } else if (std::string_view(s.key) == "stock" && v.is_number() && v.get<double>() > 0) {
+        text = fmt::format("{}", v.get<double>());  // one thickness, as `--set stock=5` gives it
       } else if (std::string_view(s.key) == "stock" && v.is_array()) {
         // The stock as a list of thicknesses in mm, like --stock 1,2.5,5.
         for (const auto& t : v) {
