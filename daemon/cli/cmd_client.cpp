@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <memory>
 
 #include <fmt/format.h>
@@ -119,6 +120,38 @@ int follow(const ClientOptions& o, const std::string& id) {
   }
 }
 
+std::string encode_base64(std::string_view bytes) {
+  static const char* alphabet = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  out.reserve((bytes.size() + 2) / 3 * 4);
+  for (std::size_t i = 0; i < bytes.size(); i += 3) {
+    const std::size_t n = std::min<std::size_t>(3, bytes.size() - i);
+    unsigned v = 0;
+    for (std::size_t k = 0; k < 3; ++k) v = v << 8 | (k < n ? static_cast<unsigned char>(bytes[i + k]) : 0u);
+    for (std::size_t k = 0; k < 4; ++k) out += k <= n ? alphabet[v >> (18 - 6 * k) & 63] : '=';
+  }
+  return out;
+}
+
+// upload.begin, then 384 kB chunks; the upload id for job.submit.
+std::expected<std::string, std::string> upload_file(const ClientOptions& o, const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return std::unexpected(fmt::format("cannot read {}", path));
+  const std::string bytes((std::istreambuf_iterator<char>(in)), {});
+  auto client = connect(o);
+  if (!client) return std::unexpected(client.error());
+  auto begun = client->call("upload.begin", {{"name", std::filesystem::path(path).filename().string()}, {"size", bytes.size()}});
+  if (!begun) return std::unexpected(begun.error().message);
+  const std::string id = (*begun)["upload"];
+  constexpr std::size_t kChunk = 384 << 10;
+  for (std::size_t offset = 0; offset < bytes.size(); offset += kChunk) {
+    const std::string_view piece = std::string_view(bytes).substr(offset, kChunk);
+    auto r = client->call("upload.chunk", {{"upload", id}, {"offset", offset}, {"data", encode_base64(piece)}}, 60);
+    if (!r) return std::unexpected(r.error().message);
+  }
+  return id;
+}
+
 void add_common(CLI::App* cmd, ClientOptions& o) {
   cmd->add_option("--socket", o.socket, "laminad's Unix socket (default $LAMINA_SOCKET or /run/lamina/lamina.sock)");
   cmd->add_option("--tcp", o.tcp, "laminad over TCP, HOST:PORT (token from --token or $LAMINA_TOKEN)");
@@ -141,6 +174,7 @@ void add_client_commands(CLI::App& app, int& exit_code) {
       std::string model, name;
       std::vector<std::string> set;
       bool follow = false;
+      bool upload = false;
     };
     auto s = std::make_shared<Submit>();
     auto* cmd = app.add_subcommand("submit", "submit a model to laminad: it plans it, then cuts it sheet by sheet");
@@ -148,6 +182,7 @@ void add_client_commands(CLI::App& app, int& exit_code) {
     cmd->add_option("--name", s->name, "the job's name (default: the file name)");
     cmd->add_option("--set", s->set, "plan setting KEY=VALUE (docs/api.md), e.g. strategy=curved microjoints=2");
     cmd->add_flag("--follow", s->follow, "show planning and cutting progress until the job needs you");
+    cmd->add_flag("--upload", s->upload, "send the file over the connection (the daemon is on another machine)");
     add_common(cmd, *o);
     cmd->callback([o, s, &exit_code, print_or] {
       Json settings = Json::object();
@@ -170,6 +205,16 @@ void add_client_commands(CLI::App& app, int& exit_code) {
       std::error_code ec;
       const std::string model = std::filesystem::absolute(s->model, ec).string();
       Json params{{"model", model}, {"settings", settings}};
+      if (s->upload) {
+        auto id = upload_file(*o, model);
+        if (!id) {
+          fmt::print(stderr, "lamina submit: {}\n", id.error());
+          exit_code = 1;
+          return;
+        }
+        params.erase("model");
+        params["upload"] = *id;
+      }
       if (!s->name.empty()) params["name"] = s->name;
       auto r = call(*o, "job.submit", params);
       if (!r) {

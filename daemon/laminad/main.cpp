@@ -122,7 +122,8 @@ int run(const fs::path& config_path, bool check_only) {
   JobManager jobs(*config, **store, *machine, [&server_ptr](const std::string& method, const nlohmann::json& params) {
     if (server_ptr) server_ptr->broadcast(method, params);
   });
-  RpcServer server(io, rs, make_api_handler(jobs, ServerInfo{kVersion, machine->describe(), config->state_dir.string()}));
+  Uploads uploads(config->state_dir / "uploads");
+  RpcServer server(io, rs, make_api_handler(jobs, uploads, ServerInfo{kVersion, machine->describe(), config->state_dir.string()}));
   server_ptr = &server;
   for (int fd : activated)
     if (auto r = server.adopt_unix_listener(fd); !r) {

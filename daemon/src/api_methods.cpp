@@ -41,7 +41,7 @@ RpcResult job_result(std::expected<JobRecord, RpcError> r) {
 
 }  // namespace
 
-RpcServer::Handler make_api_handler(JobManager& jobs, ServerInfo info) {
+RpcServer::Handler make_api_handler(JobManager& jobs, Uploads& uploads, ServerInfo info) {
   auto methods = std::make_shared<std::map<std::string, Method>>();
   auto& m = *methods;
 
@@ -53,20 +53,55 @@ RpcServer::Handler make_api_handler(JobManager& jobs, ServerInfo info) {
     client.subscribed = true;
     return Json{{"subscribed", true}, {"notifications", {"notify_job_progress", "notify_machine_status"}}};
   };
-  m["job.submit"] = [&jobs](const Json& params, ClientContext&) -> RpcResult {
+  m["upload.begin"] = [&uploads](const Json& params, ClientContext&) -> RpcResult {
     auto p = object_params(params);
     if (!p) return std::unexpected(p.error());
-    auto model = string_param(params, "model");
-    if (!model) return std::unexpected(model.error());
+    auto name = string_param(params, "name");
+    if (!name) return std::unexpected(name.error());
+    if (!params.contains("size") || !params["size"].is_number_unsigned())
+      return std::unexpected(invalid("params.size: expected the file's size in bytes"));
+    auto id = uploads.begin(*name, params["size"].get<std::uint64_t>());
+    if (!id) return std::unexpected(id.error());
+    return Json{{"upload", *id}};
+  };
+  m["upload.chunk"] = [&uploads](const Json& params, ClientContext&) -> RpcResult {
+    auto p = object_params(params);
+    if (!p) return std::unexpected(p.error());
+    auto id = string_param(params, "upload");
+    if (!id) return std::unexpected(id.error());
+    auto data = string_param(params, "data");
+    if (!data) return std::unexpected(data.error());
+    if (!params.contains("offset") || !params["offset"].is_number_unsigned())
+      return std::unexpected(invalid("params.offset: expected a byte offset"));
+    auto received = uploads.chunk(*id, params["offset"].get<std::uint64_t>(), *data);
+    if (!received) return std::unexpected(received.error());
+    return Json{{"received", *received}};
+  };
+  m["job.submit"] = [&jobs, &uploads](const Json& params, ClientContext&) -> RpcResult {
+    auto p = object_params(params);
+    if (!p) return std::unexpected(p.error());
     SubmitRequest r;
-    r.model_path = *model;
+    if (params.contains("upload") == params.contains("model"))
+      return std::unexpected(invalid("params: give either model (a path on the cell PC) or upload (from upload.begin)"));
+    if (params.contains("upload")) {
+      auto id = string_param(params, "upload");
+      if (!id) return std::unexpected(id.error());
+      auto file = uploads.take(*id);
+      if (!file) return std::unexpected(file.error());
+      r.model_path = file->string();
+      r.move_into_job = true;
+    } else {
+      auto model = string_param(params, "model");
+      if (!model) return std::unexpected(model.error());
+      r.model_path = *model;
+    }
     if (auto it = params.find("name"); it != params.end()) {
       if (!it->is_string()) return std::unexpected(invalid("params.name: expected a string"));
       r.name = it->get<std::string>();
     }
     if (auto it = params.find("settings"); it != params.end()) r.settings = *it;
     for (const auto& [key, value] : params.items())
-      if (key != "model" && key != "name" && key != "settings")
+      if (key != "model" && key != "upload" && key != "name" && key != "settings")
         return std::unexpected(invalid(fmt::format("params.{}: unknown parameter", key)));
     return job_result(jobs.submit(std::move(r)));
   };

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "job_manager.hpp"
+#include "uploads.hpp"
 #include "lamina/daemon/rpc_server.hpp"
 
 namespace lamina::daemon {
@@ -14,6 +15,6 @@ struct ServerInfo {
   std::string state_dir;
 };
 
-RpcServer::Handler make_api_handler(JobManager& jobs, ServerInfo info);
+RpcServer::Handler make_api_handler(JobManager& jobs, Uploads& uploads, ServerInfo info);
 
 }  // namespace lamina::daemon

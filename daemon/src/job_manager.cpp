@@ -181,6 +181,17 @@ std::expected<JobRecord, RpcError> JobManager::submit(SubmitRequest r) {
   job.plan_settings = r.settings.is_null() ? nlohmann::json::object() : r.settings;
   job.artefact_dir = (config_.state_dir / "jobs" / job.id).string();
   job.created_unix_ms = job.updated_unix_ms = now_unix_ms();
+  if (r.move_into_job) {
+    // An uploaded model belongs to its job: jobs/<id>/<name>, kept with the artefacts.
+    std::error_code ec;
+    fs::create_directories(job.artefact_dir, ec);
+    const std::string stored = fs::path(r.model_path).filename().string();  // "<upload id>-<name>"
+    const fs::path target = fs::path(job.artefact_dir) / stored.substr(stored.find('-') + 1);
+    fs::rename(r.model_path, target, ec);
+    if (ec) return std::unexpected(error(rpc_code::storage_error, fmt::format("{}: {}", target.string(), ec.message())));
+    job.model_path = target.string();
+    if (r.name.empty()) job.name = target.filename().string();
+  }
   if (auto s = store_.insert_job(job); !s) return std::unexpected(error(rpc_code::storage_error, s.error().message));
   event(job, "state", {{"from", nullptr}, {"to", "queued"}, {"reason", "submitted"}});
   log()->info("job {}: queued ({})", job.id, job.model_path);

@@ -31,6 +31,7 @@ struct SubmitRequest {
   std::string model_path;             // absolute, readable by the daemon
   std::string name;                   // for people; default: the file name
   nlohmann::json settings = nlohmann::json::object();  // plan settings (plan_settings.hpp)
+  bool move_into_job = false;         // an upload: the file moves into the job's folder
 };
 
 class JobManager {

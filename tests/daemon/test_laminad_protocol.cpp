@@ -9,6 +9,7 @@
 #include <sys/un.h>
 
 #include <atomic>
+#include <fstream>
 
 #include "daemon_fixture.hpp"
 
@@ -137,6 +138,56 @@ TEST(LaminadProtocol, FiftyClientsWhileAJobStreamsAreAllAnswered) {
   const Json st = sim::testing::control_status(cell.sim.control_port());
   EXPECT_EQ(st["starvation"], 0) << "the daemon kept the CNC fed while serving: " << st.dump();
   call_ok(c, "job.cancel", {{"job", id}});
+}
+
+// A model from another machine: `lamina submit --upload` sends it in chunks; the job plans it
+// from its own copy in the job's folder.
+TEST(LaminadProtocol, UploadedModelIsPlanned) {
+  Cell cell;
+  Laminad daemon(cell.config(), cell.dir.file(""));
+  (void)connect(cell.socket());
+  const std::string command = fmt::format("'{}' submit '{}/knob.stl' --upload --set stock=10 --socket '{}' --json", LAMINA_CLI,
+                                          LAMINA_EXAMPLES_DIR, cell.socket());
+  FILE* pipe = ::popen(command.c_str(), "r");
+  std::string out;
+  char buf[4096];
+  while (pipe && std::fgets(buf, sizeof buf, pipe)) out += buf;
+  ASSERT_EQ(pipe ? ::pclose(pipe) : -1, 0) << out;
+  const Json job = Json::parse(out);
+  const std::string model = job["model"];
+  EXPECT_NE(model.find("/jobs/"), std::string::npos) << "the upload lives with its job: " << model;
+  std::ifstream original(std::string(LAMINA_EXAMPLES_DIR) + "/knob.stl", std::ios::binary), copy(model, std::ios::binary);
+  EXPECT_TRUE(std::equal(std::istreambuf_iterator<char>(original), {}, std::istreambuf_iterator<char>(copy)));
+  RpcClient c = connect(cell.socket());
+  EXPECT_EQ(wait_state(c, job["id"], "waiting_sheet", 120)["state"], "waiting_sheet");
+}
+
+// sd_notify: READY=1 once the socket listens, STOPPING=1 on SIGTERM (NOTIFY_SOCKET pointed at a
+// datagram socket of the test, as systemd would).
+TEST(LaminadProtocol, TellsSystemdWhenReadyAndWhenStopping) {
+  Cell cell;
+  const std::string notify_path = cell.dir.file("notify.sock");
+  const int fd = ::socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+  sockaddr_un addr{};
+  addr.sun_family = AF_UNIX;
+  std::snprintf(addr.sun_path, sizeof addr.sun_path, "%s", notify_path.c_str());
+  ASSERT_EQ(::bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr), 0);
+  auto next_message = [&](double wait_s) {
+    pollfd p{fd, POLLIN, 0};
+    if (::poll(&p, 1, static_cast<int>(wait_s * 1000)) <= 0) return std::string();
+    char buf[4096];
+    const auto n = ::recv(fd, buf, sizeof buf, 0);
+    return n > 0 ? std::string(buf, static_cast<std::size_t>(n)) : std::string();
+  };
+  Laminad daemon(cell.config(), cell.dir.file(""), {"NOTIFY_SOCKET=" + notify_path});
+  std::string ready = next_message(20);
+  EXPECT_NE(ready.find("READY=1"), std::string::npos) << ready;
+  EXPECT_TRUE(RpcClient::connect_unix(cell.socket())) << "READY comes after the socket listens";
+  EXPECT_EQ(daemon.stop(SIGTERM), 0);
+  bool stopping = false;
+  for (std::string m = next_message(5); !m.empty(); m = next_message(1)) stopping = stopping || m.find("STOPPING=1") != std::string::npos;
+  EXPECT_TRUE(stopping);
+  ::close(fd);
 }
 
 }  // namespace

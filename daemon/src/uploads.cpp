@@ -1,0 +1,116 @@
+#include "uploads.hpp"
+
+#include <array>
+#include <fstream>
+#include <optional>
+
+#include <fmt/format.h>
+
+namespace lamina::daemon {
+namespace fs = std::filesystem;
+
+namespace {
+
+RpcError invalid(std::string message) { return RpcError{rpc_code::invalid_params, std::move(message), nullptr}; }
+
+bool model_extension(const std::string& name) {
+  const auto dot = name.rfind('.');
+  if (dot == std::string::npos) return false;
+  std::string ext = name.substr(dot + 1);
+  for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext == "stl" || ext == "obj" || ext == "3mf";
+}
+
+}  // namespace
+
+std::optional<std::string> decode_base64(std::string_view text) {
+  static const std::array<int, 256> table = [] {
+    std::array<int, 256> t{};
+    t.fill(-1);
+    const char* alphabet = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    for (int i = 0; i < 64; ++i) t[static_cast<unsigned char>(alphabet[i])] = i;
+    return t;
+  }();
+  if (text.size() % 4 != 0) return std::nullopt;
+  std::string out;
+  out.reserve(text.size() / 4 * 3);
+  for (std::size_t i = 0; i < text.size(); i += 4) {
+    int v[4];
+    int pad = 0;
+    for (int k = 0; k < 4; ++k) {
+      const char c = text[i + static_cast<std::size_t>(k)];
+      if (c == '=') {
+        // Padding only in the last group's last two places.
+        if (i + 4 != text.size() || k < 2) return std::nullopt;
+        v[k] = 0;
+        ++pad;
+      } else {
+        if (pad) return std::nullopt;
+        v[k] = table[static_cast<unsigned char>(c)];
+        if (v[k] < 0) return std::nullopt;
+      }
+    }
+    const unsigned n = static_cast<unsigned>(v[0] << 18 | v[1] << 12 | v[2] << 6 | v[3]);
+    out += static_cast<char>(n >> 16 & 0xFF);
+    if (pad < 2) out += static_cast<char>(n >> 8 & 0xFF);
+    if (pad < 1) out += static_cast<char>(n & 0xFF);
+  }
+  return out;
+}
+
+Uploads::Uploads(fs::path dir, UploadLimits limits) : dir_(std::move(dir)), limits_(limits) {
+  std::error_code ec;
+  fs::remove_all(dir_, ec);
+  fs::create_directories(dir_, ec);
+}
+
+std::expected<std::string, RpcError> Uploads::begin(const std::string& file_name, std::uint64_t size_bytes) {
+  if (file_name.empty() || file_name.size() > 200 || file_name.find('/') != std::string::npos || file_name[0] == '.')
+    return std::unexpected(invalid("params.name: a plain file name (no folders), e.g. part.stl"));
+  if (!model_extension(file_name)) return std::unexpected(invalid("params.name: an .stl, .obj or .3mf file"));
+  if (size_bytes == 0 || size_bytes > limits_.max_file_bytes)
+    return std::unexpected(invalid(fmt::format("params.size: 1 … {} bytes", limits_.max_file_bytes)));
+  std::lock_guard lock(mutex_);
+  if (open_.size() >= limits_.max_open)
+    return std::unexpected(RpcError{rpc_code::invalid_state, fmt::format("{} uploads are unfinished already", open_.size()), nullptr});
+  const std::string id = fmt::format("u{}", next_++);
+  Upload u{dir_ / (id + "-" + file_name), size_bytes, 0};
+  std::ofstream create(u.path, std::ios::binary | std::ios::trunc);
+  if (!create) return std::unexpected(RpcError{rpc_code::storage_error, fmt::format("cannot create {}", u.path.string()), nullptr});
+  open_[id] = u;
+  return id;
+}
+
+std::expected<std::uint64_t, RpcError> Uploads::chunk(const std::string& id, std::uint64_t offset, std::string_view base64) {
+  auto data = decode_base64(base64);
+  if (!data) return std::unexpected(invalid("params.data: not base64"));
+  if (data->empty() || data->size() > limits_.max_chunk_bytes)
+    return std::unexpected(invalid(fmt::format("params.data: 1 … {} bytes per chunk", limits_.max_chunk_bytes)));
+  std::lock_guard lock(mutex_);
+  auto it = open_.find(id);
+  if (it == open_.end()) return std::unexpected(invalid(fmt::format("params.upload: no upload {}", id)));
+  Upload& u = it->second;
+  // In order: the next chunk, or the last one again (a client retrying after a lost reply).
+  if (offset > u.received) return std::unexpected(invalid(fmt::format("params.offset: {} leaves a gap (received {})", offset, u.received)));
+  if (offset + data->size() > u.size)
+    return std::unexpected(invalid(fmt::format("params.offset: the chunk ends past the announced size {}", u.size)));
+  std::fstream f(u.path, std::ios::binary | std::ios::in | std::ios::out);
+  f.seekp(static_cast<std::streamoff>(offset));
+  f.write(data->data(), static_cast<std::streamsize>(data->size()));
+  if (!f) return std::unexpected(RpcError{rpc_code::storage_error, fmt::format("writing {} failed", u.path.string()), nullptr});
+  u.received = std::max(u.received, offset + data->size());
+  return u.received;
+}
+
+std::expected<fs::path, RpcError> Uploads::take(const std::string& id) {
+  std::lock_guard lock(mutex_);
+  auto it = open_.find(id);
+  if (it == open_.end()) return std::unexpected(invalid(fmt::format("params.upload: no upload {}", id)));
+  if (it->second.received != it->second.size)
+    return std::unexpected(invalid(fmt::format("params.upload: {} of {} bytes received", it->second.received, it->second.size)));
+  fs::path p = it->second.path;
+  open_.erase(it);
+  return p;
+}
+
+}  // namespace lamina::daemon

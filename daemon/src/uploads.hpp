@@ -1,0 +1,49 @@
+#pragma once
+// Models sent over the socket in chunks (job.submit with an upload) for clients that are not on
+// the cell PC: upload.begin names the file and its size, upload.chunk appends base64 pieces at
+// their offset (in order; a repeated chunk is accepted again, a gap is refused), and job.submit
+// takes the finished file. Files live in <state_dir>/uploads until a job takes them; the folder
+// is emptied at start-up (an upload does not survive the daemon).
+#include <cstdint>
+#include <expected>
+#include <filesystem>
+#include <map>
+#include <mutex>
+#include <string>
+#include <string_view>
+
+#include "lamina/daemon/rpc_server.hpp"
+
+namespace lamina::daemon {
+
+struct UploadLimits {
+  std::uint64_t max_file_bytes = 512ull << 20;   // a 10M-triangle binary STL is 500 MB
+  std::size_t max_chunk_bytes = 512 << 10;       // decoded; base64 makes it 683 kB, under the line limit
+  std::size_t max_open = 16;                     // unfinished uploads at once
+};
+
+class Uploads {
+ public:
+  Uploads(std::filesystem::path dir, UploadLimits limits = {});
+  std::expected<std::string, RpcError> begin(const std::string& file_name, std::uint64_t size_bytes);
+  // Returns the bytes received so far.
+  std::expected<std::uint64_t, RpcError> chunk(const std::string& id, std::uint64_t offset, std::string_view base64);
+  // The complete file (the upload is forgotten; the caller moves or deletes the file).
+  std::expected<std::filesystem::path, RpcError> take(const std::string& id);
+
+ private:
+  struct Upload {
+    std::filesystem::path path;
+    std::uint64_t size = 0, received = 0;
+  };
+  std::filesystem::path dir_;
+  UploadLimits limits_;
+  std::mutex mutex_;
+  std::map<std::string, Upload> open_;
+  std::uint64_t next_ = 1;
+};
+
+// RFC 4648 base64 (no line breaks); nullopt on a character outside the alphabet or bad padding.
+std::optional<std::string> decode_base64(std::string_view text);
+
+}  // namespace lamina::daemon
