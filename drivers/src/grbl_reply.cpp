@@ -4,6 +4,7 @@
 #include <utility>
 
 #include "grbl_codes.hpp"
+#include "text_fields.hpp"
 
 namespace lamina::drivers::detail {
 namespace {
@@ -19,16 +20,6 @@ std::optional<int> to_int(std::string_view s) {
   const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), value);
   if (ec != std::errc() || end != s.data() + s.size() || s.empty()) return std::nullopt;
   return value;
-}
-
-std::vector<std::string_view> split(std::string_view s, char separator) {
-  std::vector<std::string_view> parts;
-  for (;;) {
-    const auto at = s.find(separator);
-    parts.push_back(s.substr(0, at));
-    if (at == std::string_view::npos) return parts;
-    s.remove_prefix(at + 1);
-  }
 }
 
 // `error:20` / `ALARM:2`: the number, or 0 with the text kept in the line (Grbl 0.9 sent words).
@@ -69,14 +60,14 @@ bool learn_build_info(std::string_view line, ControllerInfo& info) {
   const std::string_view body = line.substr(1, line.size() - 2);
   if (starts_with(body, "OPT:")) {
     // Grbl 1.1: [OPT:V,15,128]; grblHAL adds the axis count and more after the rx size.
-    const auto fields = split(body.substr(4), ',');
+    const auto fields = split_fields(body.substr(4), ',');
     if (fields.size() > 1) info.planner_blocks = to_int(fields[1]);
     if (fields.size() > 2) info.rx_buffer_bytes = to_int(fields[2]);
     if (fields.size() > 3) info.axes = to_int(fields[3]);
     return true;
   }
   if (starts_with(body, "AXS:")) {  // grblHAL: [AXS:5:XYZAC]
-    const auto fields = split(body.substr(4), ':');
+    const auto fields = split_fields(body.substr(4), ':');
     if (auto n = to_int(fields[0])) info.axes = n;
     if (fields.size() > 1) info.axis_letters = std::string(fields[1]);
     return true;

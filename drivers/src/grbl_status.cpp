@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "lamina/drivers/controller_status.hpp"
+#include "text_fields.hpp"
 
 namespace lamina::drivers {
 namespace {
@@ -13,16 +14,6 @@ namespace {
 // Our machine is XYZAC: a report with another axis count cannot be mapped onto it.
 constexpr std::size_t kMachineAxes = 5;
 constexpr double kSecondsPerMinute = 60.0;
-
-std::vector<std::string_view> split(std::string_view s, char separator) {
-  std::vector<std::string_view> parts;
-  for (;;) {
-    const auto at = s.find(separator);
-    parts.push_back(s.substr(0, at));
-    if (at == std::string_view::npos) return parts;
-    s.remove_prefix(at + 1);
-  }
-}
 
 template <typename T>
 std::optional<T> number(std::string_view s) {
@@ -35,7 +26,7 @@ std::optional<T> number(std::string_view s) {
 // "x,y,z[,a[,b[,c]]]": Grbl reports 3 axes, grblHAL up to 6 (8 with options).
 std::optional<std::vector<double>> axes(std::string_view s) {
   std::vector<double> values;
-  for (const auto part : split(s, ',')) {
+  for (const auto part : split_fields(s, ',')) {
     const auto v = number<double>(part);
     if (!v) return std::nullopt;
     values.push_back(*v);
@@ -75,7 +66,7 @@ std::optional<ControllerStatus> parse_grbl_status(std::string_view report) {
   if (opens != closes) return std::nullopt;  // cut off: half a report is not a report
   if (opens) report = report.substr(1, report.size() - 2);
 
-  const auto fields = split(report, '|');
+  const auto fields = split_fields(report, '|');
   if (fields[0].empty()) return std::nullopt;
   ControllerStatus status;
   status.state_text = std::string(fields[0]);
@@ -98,7 +89,7 @@ std::optional<ControllerStatus> parse_grbl_status(std::string_view report) {
       if (!v) return std::nullopt;
       (key == "MPos" ? mpos : key == "WPos" ? wpos : wco) = std::move(v);
     } else if (key == "Bf") {
-      const auto parts = split(value, ',');
+      const auto parts = split_fields(value, ',');
       if (parts.size() != 2) return std::nullopt;
       status.planner_blocks_free = number<int>(parts[0]);
       status.rx_bytes_free = number<int>(parts[1]);
@@ -107,7 +98,7 @@ std::optional<ControllerStatus> parse_grbl_status(std::string_view report) {
       status.line_number = number<std::int64_t>(value);
       if (!status.line_number) return std::nullopt;
     } else if (key == "FS" || key == "F") {
-      const auto feed_mm_per_min = number<double>(split(value, ',')[0]);
+      const auto feed_mm_per_min = number<double>(split_fields(value, ',')[0]);
       if (!feed_mm_per_min) return std::nullopt;
       status.feed_mm_per_s = *feed_mm_per_min / kSecondsPerMinute;
     }

@@ -127,6 +127,22 @@ class SimProcess {
   nlohmann::json ready_;
 };
 
+// lamina-sim on a PTY in a fresh folder, with its execution log and control socket; `first`
+// goes before the common flags (e.g. a personality), `extra` after them.
+struct LoggedSim {
+  TempDir dir;
+  std::string link = dir.file("cnc");
+  std::string log = dir.file("exec.jsonl");
+  SimProcess sim;
+  explicit LoggedSim(std::vector<std::string> extra, std::vector<std::string> first = {})
+      : sim([&] {
+          std::vector<std::string> args = std::move(first);
+          args.insert(args.end(), {"--link", link, "--log", log, "--control", "127.0.0.1:0"});
+          args.insert(args.end(), extra.begin(), extra.end());
+          return args;
+        }()) {}
+};
+
 // A byte-stream client (PTY through termios, or TCP) with timed reads.
 class StreamClient {
  public:

@@ -9,17 +9,8 @@
 namespace lamina::sim::testing {
 namespace {
 
-struct FaultSim {
-  TempDir dir;
-  std::string link = dir.file("cnc");
-  std::string log = dir.file("exec.jsonl");
-  SimProcess sim;
-  explicit FaultSim(std::vector<std::string> extra)
-      : sim([&] {
-          std::vector<std::string> args{"--link", link, "--log", log, "--control", "127.0.0.1:0"};
-          args.insert(args.end(), extra.begin(), extra.end());
-          return args;
-        }()) {}
+struct FaultSim : LoggedSim {
+  explicit FaultSim(std::vector<std::string> extra) : LoggedSim(std::move(extra)) {}
   StreamClient connect() {
     StreamClient c = StreamClient::open_pty(link);
     if (!c.wait_for("Grbl", 3.0)) throw std::runtime_error("no banner");

@@ -11,17 +11,8 @@
 namespace lamina::sim::testing {
 namespace {
 
-struct PtySim {
-  TempDir dir;
-  std::string link = dir.file("cnc");
-  std::string log = dir.file("exec.jsonl");
-  SimProcess sim;
-  PtySim(std::vector<std::string> extra)
-      : sim([&] {
-          std::vector<std::string> args{"--link", link, "--log", log, "--control", "127.0.0.1:0"};
-          args.insert(args.end(), extra.begin(), extra.end());
-          return args;
-        }()) {}
+struct PtySim : LoggedSim {
+  PtySim(std::vector<std::string> extra) : LoggedSim(std::move(extra)) {}
 };
 
 double status_x(const std::string& report) {

@@ -12,18 +12,8 @@ namespace {
 
 constexpr char kDc1 = 0x11, kDc3 = 0x13, kNak = 0x15;
 
-struct XonSim {
-  TempDir dir;
-  std::string link = dir.file("cnc");
-  std::string log = dir.file("exec.jsonl");
-  SimProcess sim;
-  explicit XonSim(std::vector<std::string> extra)
-      : sim([&] {
-          std::vector<std::string> args{"--personality", "xonxoff", "--link", link, "--log", log, "--control",
-                                        "127.0.0.1:0"};
-          args.insert(args.end(), extra.begin(), extra.end());
-          return args;
-        }()) {}
+struct XonSim : LoggedSim {
+  explicit XonSim(std::vector<std::string> extra) : LoggedSim(std::move(extra), {"--personality", "xonxoff"}) {}
 };
 
 // Send bytes one at a time while the controller has not said DC3; wait for DC1 after one.
