@@ -85,7 +85,10 @@ void JobManager::cut_sheet(std::string job_id, int sheet_index, CutStart how, st
     machine_.link().start(drivers::LineSpan{{}, 0}, {});
     (void)machine_.link().wait(10);
     machine_.link().request(drivers::RealtimeCommand::feed_hold);
-    if (machine_.cell()) machine_.cell()->feed_hold();
+    // The PLC's button too, and wait until it has acted: the resume below resets the CNC over
+    // its line, and a press handed on after that reset would leave the restarted program held.
+    if (machine_.cell())
+      if (auto held = machine_.cell()->hold_cnc(); !held) log()->warn("job {}: feed hold through the PLC: {}", job_id, held.error().message);
     SheetRecord sheet;
     {
       std::lock_guard lock(mutex_);

@@ -31,7 +31,7 @@ LinkError interlock(std::string message) { return {LinkErrorCode::interlock, std
 }  // namespace
 
 struct CellIo::Impl {
-  enum class Kind { prepare, finish, reset_cnc, refresh };
+  enum class Kind { prepare, finish, reset_cnc, hold_cnc, refresh };
   struct Command {
     Kind kind;
     std::promise<Result> done;
@@ -137,6 +137,7 @@ struct CellIo::Impl {
       case Kind::prepare: return prepare();
       case Kind::finish: return finish();
       case Kind::reset_cnc: return reset_cnc();
+      case Kind::hold_cnc: return hold_cnc();
       case Kind::refresh: return read_inputs();
     }
     return {};
@@ -253,22 +254,40 @@ struct CellIo::Impl {
   // and queue are gone and it takes a new program. An alarm that outlives the reset (its cause
   // is still there) is reported with the state read.
   Result reset_cnc() {
-    if (auto r = client.write_bit(pm::kCoilCncReset, true); !r) return r;
-    log->info("CNC reset through the PLC");
+    return press_and_wait(pm::kCoilCncReset, "reset", [](ControllerState s) { return s == ControllerState::idle; },
+                          "idle");
+  }
+
+  // The feed-hold button, then the CNC's state until it stands still (held, idle, alarm, door).
+  // Returning only then matters to whoever resets the CNC next over its own line: a press the
+  // PLC hands on after that reset would hold the fresh program.
+  Result hold_cnc() {
+    return press_and_wait(pm::kCoilCncFeedHold, "feed hold", [](ControllerState s) {
+      return s == ControllerState::hold || s == ControllerState::idle || s == ControllerState::alarm ||
+             s == ControllerState::door;
+    }, "still");
+  }
+
+  template <class Accept>
+  Result press_and_wait(int coil, const char* button, Accept accept, const char* wanted) {
+    if (auto r = client.write_bit(coil, true); !r) return r;
+    log->info("CNC {} through the PLC", button);
     const auto deadline = Clock::now() + seconds(settings.cnc_reset_timeout_s);
+    const auto cancelled = [&] {
+      return std::unexpected(LinkError{LinkErrorCode::cancelled, fmt::format("CNC {}: CellIo shutting down", button)});
+    };
     // The PLC hands the press on in its next scan; a state read before that is the old one.
-    if (interrupted_sleep(std::max(0.01, settings.poll_period_s)) && stopping)
-      return std::unexpected(LinkError{LinkErrorCode::cancelled, "CNC reset: CellIo shutting down"});
+    if (interrupted_sleep(std::max(0.01, settings.poll_period_s)) && stopping) return cancelled();
     while (true) {
       if (auto r = read_inputs(); !r) return r;
       const ControllerState state = snapshot().cnc_state;
-      if (state == ControllerState::idle) return {};
+      if (accept(state)) return {};
       if (Clock::now() >= deadline)
         return std::unexpected(LinkError{LinkErrorCode::timeout,
-                                         fmt::format("the CNC is not idle {} s after the PLC's reset (state {})",
-                                                     settings.cnc_reset_timeout_s, to_string(state))});
+                                         fmt::format("the CNC is not {} {} s after the PLC's {} (state {})", wanted,
+                                                     settings.cnc_reset_timeout_s, button, to_string(state))});
       if (interrupted_sleep(std::max(0.01, settings.poll_period_s))) {
-        if (stopping) return std::unexpected(LinkError{LinkErrorCode::cancelled, "CNC reset: CellIo shutting down"});
+        if (stopping) return cancelled();
         if (jet_off_requested.exchange(false)) write_jet_off("jet_off() requested");
       }
     }
@@ -342,6 +361,7 @@ std::expected<void, LinkError> CellIo::finish_cut() { return impl_->submit(Impl:
 
 void CellIo::jet_off() { impl_->signal(impl_->jet_off_requested); }
 std::expected<void, LinkError> CellIo::reset_cnc() { return impl_->submit(Impl::Kind::reset_cnc); }
+std::expected<void, LinkError> CellIo::hold_cnc() { return impl_->submit(Impl::Kind::hold_cnc); }
 void CellIo::feed_hold() { impl_->signal(impl_->feed_hold_requested); }
 void CellIo::cycle_start() { impl_->signal(impl_->cycle_start_requested); }
 std::expected<void, LinkError> CellIo::refresh() { return impl_->submit(Impl::Kind::refresh); }

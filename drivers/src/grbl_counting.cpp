@@ -44,6 +44,7 @@ class CountingProtocol final : public LineProtocol {
     if (handshake_done_) return {};
     // Callable again after a reset swallowed the first request (the banner drops it).
     in_flight_.push_back({Awaiting::build_info, kBuildInfoRequest.size(), 0});
+    build_info_lines_ = 0;
     in_flight_bytes_ += kBuildInfoRequest.size();
     return std::string(kBuildInfoRequest);
   }
@@ -129,7 +130,10 @@ class CountingProtocol final : public LineProtocol {
         else events.emplace_back(ProtocolViolation{fmt::format("malformed status report '{}'", line)});
         return;
       case ReplyKind::info:
-        if (!in_flight_.empty() && in_flight_.front().what == Awaiting::build_info) learn_build_info(line, learned_);
+        if (!in_flight_.empty() && in_flight_.front().what == Awaiting::build_info) {
+          learn_build_info(line, learned_);
+          if (line.rfind("[MSG:", 0) != 0) ++build_info_lines_;
+        }
         return;  // [MSG:…], [GC:…], $N=…: nothing the stream depends on
       case ReplyKind::unknown:
         events.emplace_back(ProtocolViolation{fmt::format("unrecognised reply '{}'", line)});
@@ -140,6 +144,11 @@ class CountingProtocol final : public LineProtocol {
   void on_answer(const Reply& reply, std::vector<ProtocolEvent>& events) {
     if (in_flight_.empty()) {
       events.emplace_back(ProtocolViolation{fmt::format("'{}' with nothing in flight", reply.line)});
+      return;
+    }
+    if (in_flight_.front().what == Awaiting::build_info && reply.kind == ReplyKind::ok && build_info_lines_ == 0) {
+      // `$I` prints its build info before its ok; an ok before any of it answers a line of an
+      // earlier host that the controller is still draining. Not ours: the handshake waits on.
       return;
     }
     const InFlight answered = in_flight_.front();
@@ -202,6 +211,7 @@ class CountingProtocol final : public LineProtocol {
   ReplyLineSplitter splitter_;
   ControllerInfo learned_;
   bool handshake_done_ = false;
+  int build_info_lines_ = 0;  // [VER:]/[OPT:]… lines seen since our `$I` went out
   std::deque<InFlight> in_flight_;
   std::size_t in_flight_bytes_ = 0;
   LineSpan span_;

@@ -134,6 +134,7 @@ std::expected<std::unique_ptr<Transport>, LinkError> open_libserialport(boost::a
     close_port();
     return std::unexpected(configured.error());
   }
+  (void)sp_flush(raw, SP_BUF_INPUT);  // replies meant for an earlier connection (as open_termios)
   int fd = -1;
   if (const sp_return r = sp_get_port_handle(raw, &fd); r != SP_OK || fd < 0) {
     close_port();

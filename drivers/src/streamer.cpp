@@ -64,7 +64,8 @@ struct Streamer::Impl {
   std::atomic<int> resets_seen{0};    // banners while not streaming (recover() waits for one)
   std::atomic<bool> flow_held{false};  // the protocol's flow_stopped(), readable off the io thread
   bool awaiting_banner = false;
-  Clock::time_point connected_at{};
+  Clock::time_point connected_at{};  // restarted by stale replies: the quiet period's start
+  Clock::time_point opened_at{};
   int idle_with_lines_in_flight = 0;  // consecutive Idle reports while we wait for acks
   std::size_t accepted_at_last_status = 0;
 
@@ -115,8 +116,10 @@ struct Streamer::Impl {
       // greeting). Anything sent before it may be lost or answered out of turn, so the
       // handshake waits for the banner, or for a short quiet period when none comes.
       awaiting_banner = true;
-      connected_at = Clock::now();
+      connected_at = opened_at = Clock::now();
       read_more();
+    } else if (awaiting_banner) {
+      opened_at = Clock::now();  // a new job gives a chattering controller a new chance
     }
     pending_span = std::move(span);
     schedule_tick();
@@ -236,6 +239,13 @@ struct Streamer::Impl {
         if (info->planner_blocks) shared_progress.planner_blocks = info->planner_blocks;
         if (info->rx_buffer_bytes) shared_progress.rx_buffer_bytes = info->rx_buffer_bytes;
       } else if (const auto* v = std::get_if<ProtocolViolation>(&event)) {
+        if (awaiting_banner) {
+          // We have not said a word on this connection yet: an `ok` for a host that died (the
+          // controller drains the queue it was given) is not ours. Wait for quiet again.
+          spdlog::info("link: ignored before the handshake (left from an earlier connection): {}", v->what);
+          connected_at = Clock::now();
+          continue;
+        }
         finish(LinkError{LinkErrorCode::protocol_error, v->what});
       }
     }
@@ -367,6 +377,12 @@ struct Streamer::Impl {
 
   void on_tick() {
     const auto now = Clock::now();
+    if (awaiting_banner && streaming && seconds_between(opened_at, now) > settings.handshake_timeout_s) {
+      finish(LinkError{LinkErrorCode::timeout,
+                       fmt::format("{}: the controller kept sending replies nobody asked for for {} s",
+                                   transport ? transport->describe() : "link", settings.handshake_timeout_s)});
+      return;
+    }
     if (awaiting_banner && seconds_between(connected_at, now) > kBannerWaitS) {
       awaiting_banner = false;
       if (streaming) send_handshake_or_load();

@@ -109,6 +109,9 @@ std::expected<std::unique_ptr<Transport>, LinkError> open_termios(boost::asio::i
   }
   if (auto applied = apply(port, path, settings, *baud); !applied) return std::unexpected(applied.error());
   if (auto raw = check_raw(port, path); !raw) return std::unexpected(raw.error());
+  // What the controller said to an earlier connection (acks of a host that died) is not an
+  // answer to us: drop what is buffered; the Streamer ignores stragglers until the banner.
+  ::tcflush(port.native_handle(), TCIFLUSH);
 
   SerialSettings actual = settings;
   actual.baud = *baud;  // describe what the line runs at

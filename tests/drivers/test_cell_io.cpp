@@ -236,6 +236,28 @@ TEST(CellIo, ResetCncFlushesAHeldProgramAndReturnsWhenTheCncIsIdle) {
   EXPECT_EQ(sim::testing::control_status(cell.sim.control_port())["queued_blocks"], 0) << "the queue was flushed";
 }
 
+// hold_cnc() returns only once the PLC has handed the press on: the CNC reads held at once,
+// so a reset over the line that follows cannot be overtaken by a late hold.
+TEST(CellIo, HoldCncReturnsOnceTheCncIsHeld) {
+  SimCell cell({"--personality", "xonxoff", "--time-scale", "1"});
+  PlcProbe plc(cell.sim.modbus_port());
+  auto client = sim::testing::StreamClient::open_pty(cell.dir.file("cnc"));
+  std::string program = "%\n";
+  for (int i = 0; i < 20; ++i) program += fmt::format("G1X{}F600\n", 10 * (i % 2));
+  ASSERT_TRUE(client.send(program));
+  ASSERT_TRUE(eventually([&] { return plc.in_reg(map::kInCncState) == 1; }, 3.0)) << "running";
+  CellIo io(settings_for(cell.sim.modbus_port()));
+  const auto r = io.hold_cnc();
+  ASSERT_TRUE(r) << r.error().message;
+  EXPECT_EQ(plc.in_reg(map::kInCncState), 3) << "held when hold_cnc() returned";
+  EXPECT_EQ(io.status().cnc_state, ControllerState::hold);
+  // An idle CNC stands still already: no wait beyond the PLC's scan.
+  ASSERT_TRUE(io.reset_cnc());
+  const auto t0 = std::chrono::steady_clock::now();
+  ASSERT_TRUE(io.hold_cnc());
+  EXPECT_LT(seconds_since(t0), 1.0);
+}
+
 // The e-stop outlives any reset: reset_cnc() says the CNC stayed in alarm, within its timeout.
 TEST(CellIo, ResetCncWithTheEstopPressedNamesTheAlarm) {
   SimCell cell;

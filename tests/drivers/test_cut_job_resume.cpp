@@ -172,6 +172,43 @@ void pressure_drop_then_resume(const std::string& protocol) {
   expect_resumed_once_from_contour_start(records(dir.file("exec.jsonl")), program, restart);
 }
 
+// A host that dies mid-program (laminad killed) leaves the controller draining its queue: the
+// acks of the lines it still had in its receive buffer keep coming after a new host opened the
+// port. They are not answers to the new host; it ignores them until the line goes quiet, then
+// streams its own program, which runs after the old one, every line once.
+TEST(CutJobResume, ANewHostIgnoresTheAcksMeantForTheOneThatDied) {
+  TempDir dir;
+  SimProcess sim({"--link", dir.file("cnc"), "--log", dir.file("exec.jsonl"), "--control", "127.0.0.1:0",
+                  "--time-scale", "1"});
+  std::vector<std::string> first{"G21G90G94"};  // 100 blocks fill the planner, 20 wait in the receive buffer
+  for (int i = 0; i < 119; ++i) first.push_back(fmt::format("G1X{}F600", i % 2));  // 0.1 s each
+  {
+    auto dead_host = sim::testing::StreamClient::open_pty(dir.file("cnc"));
+    std::string bytes;
+    for (const auto& l : first) bytes += l + "\n";
+    ASSERT_TRUE(dead_host.send(bytes));
+    ASSERT_TRUE(sim::testing::wait_status(sim.control_port(), [](const nlohmann::json& st) {
+      return st["queued_blocks"].get<int>() >= 90;
+    }, 10));
+  }  // closed without reading a byte
+  const std::vector<std::string> second{"G0X20", "G1X21F600", "G1X22F600", "G0X0"};
+  auto link = pty_link(dir.file("cnc"));
+  link->start(LineSpan{second, 0}, {});
+  const auto outcome = link->wait(30);
+  ASSERT_TRUE(outcome);
+  ASSERT_TRUE(outcome->completed) << outcome->error->message;
+  // Had a stale ok ended the `$I` handshake, the window would be classic Grbl's 128 bytes and
+  // the acks that followed would have been counted for our lines before they were taken.
+  EXPECT_EQ(link->progress().rx_buffer_bytes, 1024) << "the window came from the controller's own [OPT:]";
+  ASSERT_TRUE(sim::testing::wait_status(sim.control_port(), [](const nlohmann::json& st) {
+    return st["queued_blocks"] == 0 && st["state"] == "idle";
+  }, 30));
+  const auto log = records(dir.file("exec.jsonl"));
+  ASSERT_EQ(log.size(), first.size() + second.size());
+  for (std::size_t i = 0; i < first.size(); ++i) ASSERT_EQ(log[i].line, first[i]) << "block " << i + 1;
+  for (std::size_t i = 0; i < second.size(); ++i) ASSERT_EQ(log[first.size() + i].line, second[i]);
+}
+
 TEST(CutJobResume, DripFeedStoppedByThePlcResumesFromTheContourStart) { pressure_drop_then_resume("xonxoff"); }
 TEST(CutJobResume, MailboxStoppedByThePlcResumesFromTheContourStart) { pressure_drop_then_resume("modbus"); }
 

@@ -56,6 +56,26 @@ TEST(GrblProtocol, ResetDuringTheHandshakeNeedsItAgain) {
   EXPECT_TRUE(p->handshake_done());
 }
 
+TEST(GrblProtocol, AnOkBeforeTheBuildInfoIsAnEarlierHostsAndIgnored) {
+  // laminad restarted while the controller drains the lines the dead daemon gave it: their
+  // acks arrive after our `$I`. Only the ok that follows the build info ends the handshake.
+  auto p = make_grbl_protocol();
+  EXPECT_EQ(p->handshake(), "$I\n");
+  EXPECT_TRUE(feed_bytewise(*p, "ok\r\nok\r\n[MSG:'$H'|'$X' to unlock]\r\nok\r\n").empty());
+  EXPECT_FALSE(p->handshake_done());
+  p->load(program(2, 10));
+  EXPECT_EQ(p->take_sendable(), "");
+  const auto info = only<ControllerInfo>(feed_bytewise(*p, "[VER:1.1f.20240501:]\r\n[OPT:VNL,35,1024,5,0]\r\nok\r\n"));
+  ASSERT_EQ(info.size(), 1u);
+  EXPECT_EQ(info[0].rx_buffer_bytes, 1024);
+  EXPECT_EQ(count_lines(p->take_sendable()), 2u);
+  // A controller without `$I` refuses it outright: that error ends the handshake too.
+  auto old = make_grbl_protocol();
+  old->handshake();
+  EXPECT_EQ(only<ControllerInfo>(feed_bytewise(*old, "error:3\r\n")).size(), 1u);
+  EXPECT_TRUE(old->handshake_done());
+}
+
 TEST(GrblProtocol, WindowComesFromOptUnlessConfigured) {
   // Learned 256: five 50-byte lines fit (250), a sixth would not.
   auto learned = connected_grbl(256);

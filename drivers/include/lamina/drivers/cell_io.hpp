@@ -29,7 +29,7 @@ struct CellIoSettings {
   double pump_ready_timeout_s = 10;      // pump on → pump_ready
   double min_pressure_fraction = 0.9;    // below this × set point while cutting: pressure fault
   int max_reconnects = 3;                // per fault, then the cell is declared lost
-  double cnc_reset_timeout_s = 5;        // the PLC's reset button → the CNC reads idle
+  double cnc_reset_timeout_s = 5;        // the PLC's reset (hold) button → the CNC reads idle (still)
 };
 
 enum class CellFault {
@@ -86,6 +86,10 @@ class CellIo {
   // Blocking: returns once the PLC reads the CNC idle again, or an error naming the state it
   // stayed in (an alarm whose cause is still there) after cnc_reset_timeout_s.
   std::expected<void, LinkError> reset_cnc();
+  // The feed-hold button, blocking: returns once the PLC reads the CNC still (held, idle, alarm,
+  // door), so the press cannot land after whatever the caller does next (a reset over the line
+  // followed by a new program would otherwise start held). Timeout: cnc_reset_timeout_s.
+  std::expected<void, LinkError> hold_cnc();
   // After the cut (or a stop): jet off, abrasive off, pump to idle (pump_enable = 0). Blocking.
   std::expected<void, LinkError> finish_cut();
   // While a cut is prepared, the first fault seen (sticky until the next prepare_cut); the
