@@ -31,7 +31,7 @@ using namespace lamina::daemon;
 
 namespace {
 
-constexpr const char* kVersion = "0.7.0";
+constexpr const char* kVersion = LAMINA_VERSION;  // the project's (CMakeLists.txt), as the package's
 
 // `lamina` for planning: configured, else beside laminad (build tree), else ../bin (installed).
 fs::path find_lamina(const std::string& configured) {
@@ -187,6 +187,7 @@ int main(int argc, char** argv) {
   bool check = false;
   app.add_option("--config", config_path, "configuration file (TOML)");
   app.add_flag("--check-config", check, "validate the configuration and exit");
+  app.set_version_flag("--version", std::string("laminad ") + kVersion);
   CLI11_PARSE(app, argc, argv);
   setup_logging();
   try {
