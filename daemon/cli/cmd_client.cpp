@@ -243,11 +243,27 @@ void add_client_commands(CLI::App& app, int& exit_code) {
       });
     });
   }
-  // job / cancel / resume / confirm: one job each
+  // job / cancel / confirm: one job each; resume: a job, or without one the held machine
+  {
+    auto id = std::make_shared<std::string>();
+    auto* cmd = app.add_subcommand(
+        "resume", "resume a paused or interrupted JOB (from the start of the contour it was cutting); "
+                  "without JOB: continue after a hold (as lamina continue)");
+    cmd->add_option("job", *id, "job id");
+    add_common(cmd, *o);
+    cmd->callback([o, id, &exit_code, print_or] {
+      auto r = id->empty() ? call(*o, "machine.resume") : call(*o, "job.resume", {{"job", *id}});
+      if (!r) {
+        exit_code = 1;
+        return;
+      }
+      if (id->empty()) print_or(*r, [](const Json& j) { fmt::print("{}\n", j.dump()); });
+      else print_or(*r, [](const Json& j) { print_job(j); });
+    });
+  }
   for (const auto& [name, method, help] : std::vector<std::tuple<std::string, std::string, std::string>>{
            {"job", "job.get", "show one job"},
-           {"cancel", "job.cancel", "cancel a job (a cut in progress stops safely first)"},
-           {"resume", "job.resume", "resume a paused or interrupted job (from the start of the contour it was cutting)"}}) {
+           {"cancel", "job.cancel", "cancel a job (a cut in progress stops safely first)"}}) {
     auto id = std::make_shared<std::string>();
     auto* cmd = app.add_subcommand(name, help);
     cmd->add_option("job", *id, "job id")->required();
@@ -297,7 +313,7 @@ void add_client_commands(CLI::App& app, int& exit_code) {
     });
   }
   for (const auto& [name, method, help] : std::vector<std::tuple<std::string, std::string, std::string>>{
-           {"hold", "machine.hold", "feed hold now (the job pauses; lamina continue goes on)"},
+           {"hold", "machine.hold", "feed hold now (the job pauses; lamina resume goes on)"},
            {"continue", "machine.resume", "continue after a hold (or resume the stopped job)"},
            {"abort", "machine.abort", "stop the cut now: jet off, motion held; resume or cancel the job afterwards"}}) {
     auto* cmd = app.add_subcommand(name, help);

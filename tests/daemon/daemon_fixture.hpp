@@ -161,6 +161,22 @@ inline Json wait_state(RpcClient& c, const std::string& id, const std::string& s
   return wait_job(c, id, [&](const Json& j) { return j["state"] == state || j["state"] == "failed"; }, wait_s);
 }
 
+// The `lamina` client as an operator types it: exit status and output (stdout and stderr).
+struct ClientRun {
+  int exit_code = -1;
+  std::string output;
+};
+inline ClientRun run_client(const std::string& socket, const std::string& args) {
+  const std::string command = fmt::format("timeout -k 5 120 '{}' {} --socket '{}' 2>&1 < /dev/null", LAMINA_CLI, args, socket);
+  ClientRun r;
+  FILE* pipe = ::popen(command.c_str(), "r");
+  char buf[4096];
+  while (pipe && std::fgets(buf, sizeof buf, pipe)) r.output += buf;
+  const int status = pipe ? ::pclose(pipe) : -1;
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
 // The program lines a sheet's file holds, as the daemon streams them (blank lines dropped).
 inline std::vector<std::string> program_lines(const std::string& path) {
   std::vector<std::string> lines;

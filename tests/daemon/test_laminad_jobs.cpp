@@ -70,6 +70,7 @@ TEST(LaminadJobs, SubmittedModelIsPlannedAndEverySheetCutLineForLine) {
   EXPECT_EQ(st["cell"]["jet_is_on"], false);
 }
 
+// Through the client as the operator types it: `lamina hold`, `lamina status`, `lamina resume`.
 TEST(LaminadJobs, HoldThenResumeFinishesTheSheet) {
   Cell cell({}, 40);
   Laminad daemon(cell.config(), cell.dir.file(""));
@@ -80,14 +81,20 @@ TEST(LaminadJobs, HoldThenResumeFinishesTheSheet) {
   ASSERT_EQ(job["state"], "waiting_sheet") << daemon.log();
   call_ok(c, "job.confirm_sheet", {{"job", id}, {"sheet", 1}});
   ASSERT_TRUE(sim::testing::wait_status(cell.sim.control_port(), [](const Json& s) { return s["executed_blocks"] > 100; }, 60));
-  call_ok(c, "machine.hold");
+  const ClientRun hold = run_client(cell.socket(), "hold");
+  ASSERT_EQ(hold.exit_code, 0) << hold.output;
   job = call_ok(c, "job.get", {{"job", id}});
   EXPECT_EQ(job["state"], "paused");
   ASSERT_TRUE(sim::testing::wait_status(cell.sim.control_port(), [](const Json& s) { return s["state"] == "hold"; }, 10));
   const auto held_at = executed(cell.log()).size();
   std::this_thread::sleep_for(std::chrono::milliseconds(500));
   EXPECT_EQ(executed(cell.log()).size(), held_at) << "nothing runs while held";
-  call_ok(c, "machine.resume");
+  const ClientRun status = run_client(cell.socket(), "status");
+  EXPECT_EQ(status.exit_code, 0);
+  EXPECT_EQ(status.output.rfind("hold  X", 0), 0u) << "state, then the position: " << status.output;
+  EXPECT_NE(status.output.find("job " + id), std::string::npos) << status.output;
+  const ClientRun resume = run_client(cell.socket(), "resume");  // no job: the held machine goes on
+  ASSERT_EQ(resume.exit_code, 0) << resume.output;
   job = run_to_completion(c, id, 300);
   ASSERT_EQ(job["state"], "completed") << job.dump(2);
   const auto lines = program_lines(job["sheets"][0]["program"]);

@@ -146,14 +146,10 @@ TEST(LaminadProtocol, UploadedModelIsPlanned) {
   Cell cell;
   Laminad daemon(cell.config(), cell.dir.file(""));
   (void)connect(cell.socket());
-  const std::string command = fmt::format("'{}' submit '{}/knob.stl' --upload --set stock=10 --socket '{}' --json", LAMINA_CLI,
-                                          LAMINA_EXAMPLES_DIR, cell.socket());
-  FILE* pipe = ::popen(command.c_str(), "r");
-  std::string out;
-  char buf[4096];
-  while (pipe && std::fgets(buf, sizeof buf, pipe)) out += buf;
-  ASSERT_EQ(pipe ? ::pclose(pipe) : -1, 0) << out;
-  const Json job = Json::parse(out);
+  const ClientRun run = run_client(cell.socket(), fmt::format("submit '{}/knob.stl' --upload --set stock=10 --json",
+                                                             LAMINA_EXAMPLES_DIR));
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const Json job = Json::parse(run.output);
   const std::string model = job["model"];
   EXPECT_NE(model.find("/jobs/"), std::string::npos) << "the upload lives with its job: " << model;
   std::ifstream original(std::string(LAMINA_EXAMPLES_DIR) + "/knob.stl", std::ios::binary), copy(model, std::ios::binary);
