@@ -93,10 +93,18 @@ int follow(const ClientOptions& o, const std::string& id) {
   if (!job) return 1;
   Json j = *job;
   const bool tty = ::isatty(STDERR_FILENO);
+  int planning_step_shown = 0;
   while (true) {
     const std::string state = j.value("state", "");
     if (j.value("id", "") == id) {
       std::string line = fmt::format("{} {}", id, state);
+      if (j.contains("planning") && j["planning"].is_object()) {
+        const Json& p = j["planning"];
+        const int step = p.value("step", 0), steps = p.value("steps", 0);
+        line += fmt::format(" {} {}/{} {}", bar(steps ? double(step - 1) / steps : 0), step, steps, p.value("phase", ""));
+        if (!tty && step != planning_step_shown) fmt::print(stderr, "{}\n", line);  // a log keeps each phase
+        planning_step_shown = step;
+      }
       if (j.contains("progress")) {
         const Json& p = j["progress"];
         const double f = p.value("lines", 0) ? p.value("lines_accepted", 0) / double(p.value("lines", 1)) : 0;

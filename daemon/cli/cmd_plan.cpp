@@ -3,6 +3,7 @@
 #include "commands.hpp"
 #include "plan_cam.hpp"
 #include "plan_options.hpp"
+#include "plan_progress.hpp"
 #include "plan_report.hpp"
 
 #include "lamina/core/stack_mesh.hpp"
@@ -112,7 +113,9 @@ int run_plan(const PlanOptions& o, const CamOptions& cam_options) {
   }
   auto dir = prepare_out_dir(o.out_dir);
   if (!dir) return report_error(dir.error());
+  PlanProgress progress(o.progress_fd, cam_settings ? 7 : 5);
 
+  progress.phase("reading the model");
   auto model = load_model(o.model);
   if (!model) return report_error(model.error());
   const Mesh& mesh = model->mesh;
@@ -126,6 +129,7 @@ int run_plan(const PlanOptions& o, const CamOptions& cam_options) {
   r.timing.read = model->read_s;
   r.timing.topology = model->topology_s;
 
+  progress.phase("choosing layers");
   auto t0 = Clock::now();
   auto layering = choose_layers(mesh, layering_params(*settings));
   r.timing.layering = seconds_since(t0);
@@ -133,6 +137,7 @@ int run_plan(const PlanOptions& o, const CamOptions& cam_options) {
   r.layering = std::move(*layering);
   r.warnings.insert(r.warnings.end(), r.layering.warnings.begin(), r.layering.warnings.end());
 
+  progress.phase("planning bevels");
   t0 = Clock::now();
   auto plan = plan_bevels(mesh, r.layering.layers, bevel_params(*settings, settings->strategy));
   r.timing.bevel = seconds_since(t0);
@@ -141,6 +146,7 @@ int run_plan(const PlanOptions& o, const CamOptions& cam_options) {
   add_plan_warnings(*settings, r.plan, r.warnings);
 
   // The same layering cut three ways; the chosen strategy's plan is reused, not recomputed.
+  progress.phase("measuring deviation");
   t0 = Clock::now();
   for (const BevelStrategy s : {BevelStrategy::vertical, BevelStrategy::sloped, BevelStrategy::curved}) {
     std::optional<BevelPlan> other;
@@ -155,6 +161,7 @@ int run_plan(const PlanOptions& o, const CamOptions& cam_options) {
   }
   r.timing.deviation = seconds_since(t0);
 
+  progress.phase("writing the stack");
   t0 = Clock::now();
   const std::string stl = binary_stl_bytes(stack_mesh(r.plan), stl_header(o, r));
   // A report.json left from an earlier run must not sit next to the new stack.stl.
@@ -168,11 +175,13 @@ int run_plan(const PlanOptions& o, const CamOptions& cam_options) {
   std::optional<CamResult> cam;
   remove_old_sheet_files(*dir);
   if (cam_settings) {
+    progress.phase("nesting and programs");
     const Stock stock = sized_stock(settings->stock, cam_settings->machine, r.warnings);
     auto c = plan_cam(r.plan, stock, *cam_settings, fs::path(o.model.path).filename().string());
     if (!c) return report_error(c.error());
     cam = std::move(*c);
     r.warnings.insert(r.warnings.end(), cam->warnings.begin(), cam->warnings.end());
+    progress.phase("writing sheets");
     t0 = Clock::now();
     for (const SheetOutput& s : cam->sheets) {
       for (const auto& [name, bytes] : {std::pair{s.program_name, &s.program.text}, std::pair{s.svg_name, &s.svg}})
@@ -189,6 +198,7 @@ int run_plan(const PlanOptions& o, const CamOptions& cam_options) {
   }
   if (auto w = write_file_atomically(*dir, "report.json", report.dump(2) + "\n"); !w)
     return report_error({ErrorCode::io_error, w.error()});
+  progress.done();
 
   if (o.json) {
     fmt::print("{}\n", report.dump(2));

@@ -105,6 +105,8 @@ void add_plan_options(CLI::App& cmd, PlanOptions& o) {
       ->capture_default_str();
   cmd.add_option("--out", o.out_dir, "Folder for stack.stl and report.json (created if missing)")->required();
   cmd.add_flag("--json", o.json, "Print the report as JSON on stdout instead of the tables");
+  cmd.add_option("--progress-fd", o.progress_fd, "Write one JSON line per planning phase to this open file descriptor")
+      ->check(CLI::NonNegativeNumber);
   cmd.add_flag("--all-rows", o.all_rows, "Print every layer in the table");
   cmd.footer(
       "All plan lengths (--stock, --bond, --sub-slice, --tolerance, --deviation-step) are in mm and\n"

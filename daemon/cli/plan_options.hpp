@@ -35,6 +35,7 @@ struct PlanOptions {
   std::string out_dir;
   bool json = false;
   bool all_rows = false;
+  int progress_fd = -1;                   // --progress-fd: phase lines for laminad (plan_progress.hpp)
 };
 
 // Validated, in core units.

@@ -394,12 +394,24 @@ void JobManager::plan_job(const std::string& id) {
       request.flags.insert(request.flags.end(), {"--materials", config_.planner.materials_file});
     request.timeout_s = config_.planner.timeout_s;
   }
-  auto report = run_plan_process(request, *cancel);
+  auto report = run_plan_process(request, *cancel, [this, &id](const nlohmann::json& phase) {
+    nlohmann::json j;
+    {
+      std::lock_guard lock(mutex_);
+      JobRecord* job = find(id);
+      if (!job || job->state != JobState::planning) return;
+      job->planning = {{"phase", phase.value("phase", "")}, {"step", phase.value("step", 0)},
+                       {"steps", phase.value("steps", 0)}};
+      j = to_json(*job);
+    }
+    if (notify_) notify_("notify_job_progress", j);
+  });
 
   std::lock_guard lock(mutex_);
   plan_cancel_.erase(id);
   JobRecord* job = find(id);
   if (!job) return;
+  job->planning = nullptr;
   if (!report) {
     if (stopping_ && !report.error().cancelled) return;
     if (report.error().cancelled && stopping_) {

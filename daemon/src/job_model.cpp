@@ -69,7 +69,7 @@ nlohmann::json to_json(const SheetRecord& s) {
 nlohmann::json to_json(const JobRecord& job) {
   nlohmann::json sheets = nlohmann::json::array();
   for (const SheetRecord& s : job.sheets) sheets.push_back(to_json(s));
-  return {{"id", job.id},
+  nlohmann::json j{{"id", job.id},
           {"state", to_string(job.state)},
           {"name", job.name},
           {"model", job.model_path},
@@ -81,6 +81,8 @@ nlohmann::json to_json(const JobRecord& job) {
           {"summary", job.summary},
           {"created_unix_ms", job.created_unix_ms},
           {"updated_unix_ms", job.updated_unix_ms}};
+  if (job.state == JobState::planning && !job.planning.is_null()) j["planning"] = job.planning;
+  return j;
 }
 
 nlohmann::json to_json(const JobEvent& e) {

@@ -34,16 +34,52 @@ std::string tail_of_log(const std::filesystem::path& log) {
   return errors.empty() ? last : errors;
 }
 
+// The descriptor the planner writes its phases to, as the child sees it.
+constexpr int kProgressFd = 3;
+
+// Complete lines from the progress pipe (non-blocking); a partial line waits for the rest.
+void drain_progress(int fd, std::string& pending, const PlanProgressCallback& on_progress) {
+  char buf[1024];
+  while (true) {
+    const ssize_t n = ::read(fd, buf, sizeof buf);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) break;
+    pending.append(buf, static_cast<std::size_t>(n));
+  }
+  for (std::size_t eol; (eol = pending.find('\n')) != std::string::npos;) {
+    const std::string line = pending.substr(0, eol);
+    pending.erase(0, eol + 1);
+    auto j = nlohmann::json::parse(line, nullptr, false);
+    if (!j.is_discarded() && j.is_object() && on_progress) on_progress(j);
+  }
+  if (pending.size() > 4096) pending.clear();  // not ours to keep: no line is that long
+}
+
 }  // namespace
 
 std::expected<nlohmann::json, PlanProcessError> run_plan_process(const PlanProcessRequest& r,
-                                                                 const std::atomic<bool>& cancel) {
+                                                                 const std::atomic<bool>& cancel,
+                                                                 const PlanProgressCallback& on_progress) {
   std::error_code ec;
   std::filesystem::create_directories(r.out_dir, ec);
   if (ec) return std::unexpected(PlanProcessError{false, fmt::format("{}: {}", r.out_dir.string(), ec.message())});
   const std::filesystem::path log = r.out_dir / "plan.log";
 
-  std::vector<std::string> args{r.lamina.string(), "plan", r.model.string(), "--out", r.out_dir.string(), "--json"};
+  int progress_pipe[2] = {-1, -1};
+  if (::pipe2(progress_pipe, O_CLOEXEC | O_NONBLOCK) != 0)
+    return std::unexpected(PlanProcessError{false, fmt::format("cannot make the progress pipe: {}", std::strerror(errno))});
+  // The child's end blocks (a planner must not lose a line to EAGAIN); ours does not.
+  ::fcntl(progress_pipe[1], F_SETFL, ::fcntl(progress_pipe[1], F_GETFL) & ~O_NONBLOCK);
+  struct Closer {
+    int* fds;
+    ~Closer() {
+      for (int i = 0; i < 2; ++i)
+        if (fds[i] >= 0) ::close(fds[i]);
+    }
+  } closer{progress_pipe};
+
+  std::vector<std::string> args{r.lamina.string(), "plan", r.model.string(), "--out", r.out_dir.string(), "--json",
+                                "--progress-fd", std::to_string(kProgressFd)};
   args.insert(args.end(), r.flags.begin(), r.flags.end());
   std::vector<char*> argv;
   for (auto& a : args) argv.push_back(a.data());
@@ -54,19 +90,28 @@ std::expected<nlohmann::json, PlanProcessError> run_plan_process(const PlanProce
   posix_spawn_file_actions_addopen(&actions, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
   posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0640);
   posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
+  posix_spawn_file_actions_adddup2(&actions, progress_pipe[1], kProgressFd);  // dup2 drops O_CLOEXEC
   pid_t pid = -1;
   const int rc = ::posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), environ);
   posix_spawn_file_actions_destroy(&actions);
   if (rc != 0)
     return std::unexpected(PlanProcessError{false, fmt::format("cannot start {}: {}", args[0], std::strerror(rc))});
 
+  ::close(progress_pipe[1]);  // the child holds the write end now
+  progress_pipe[1] = -1;
+  std::string pending;
+
   const auto started = Clock::now();
   std::optional<Clock::time_point> term_sent;
   bool cancelled = false, timed_out = false;
   int status = 0;
   while (true) {
+    drain_progress(progress_pipe[0], pending, on_progress);
     const pid_t done = ::waitpid(pid, &status, WNOHANG);
-    if (done == pid) break;
+    if (done == pid) {
+      drain_progress(progress_pipe[0], pending, on_progress);  // its last lines
+      break;
+    }
     if (done < 0 && errno != EINTR) return std::unexpected(PlanProcessError{false, "waitpid failed"});
     const auto now = Clock::now();
     if (!term_sent && (cancel.load() || std::chrono::duration<double>(now - started).count() > r.timeout_s)) {

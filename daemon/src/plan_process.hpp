@@ -6,6 +6,7 @@
 #include <atomic>
 #include <expected>
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -26,9 +27,14 @@ struct PlanProcessError {
   std::string message;  // the planner's last error lines, or what failed around it
 };
 
+// One phase line of the planner (`lamina plan --progress-fd`): {phase, step, steps}.
+using PlanProgressCallback = std::function<void(const nlohmann::json&)>;
+
 // Blocking (a worker thread). Returns report.json as parsed. `cancel` is polled every 50 ms:
-// SIGTERM, then SIGKILL 2 s later.
+// SIGTERM, then SIGKILL 2 s later. `on_progress` (optional) runs on this thread as each phase
+// starts; the planner writes them to a pipe, a line that is not JSON is skipped.
 std::expected<nlohmann::json, PlanProcessError> run_plan_process(const PlanProcessRequest& request,
-                                                                 const std::atomic<bool>& cancel);
+                                                                 const std::atomic<bool>& cancel,
+                                                                 const PlanProgressCallback& on_progress = {});
 
 }  // namespace lamina::daemon

@@ -5,10 +5,12 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <fstream>
 #include <set>
 #include <sstream>
 #include <string>
+#include <vector>
 
 namespace {
 
@@ -118,6 +120,44 @@ TEST(CliSheets, GrblhalWithRtcpAndUnknownMaterialAreRefused) {
   EXPECT_EQ(r.exit_code, 2) << r.out;
   EXPECT_TRUE(has_text(r, "unobtainium")) << r.out;
   EXPECT_TRUE(has_text(r, "aluminium 6061-T6")) << r.out;  // the known names are listed
+}
+
+// laminad reads these lines from a pipe to show planning as steps.
+std::vector<json> progress_lines(const fs::path& file) {
+  std::vector<json> lines;
+  std::ifstream in(file);
+  for (std::string line; std::getline(in, line);) lines.push_back(json::parse(line));
+  return lines;
+}
+
+TEST(CliSheets, ProgressFdGetsOneLinePerPhaseInOrder) {
+  TempDir out("progress");
+  fs::create_directories(out.path);
+  const fs::path file = out.path / "progress.jsonl";
+  const auto r = lamina("plan " + quoted(kKnob) + " --stock 5 --out " + quoted(out.path / "plan") +
+                        " --progress-fd 3 3>" + quoted(file));
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  const auto lines = progress_lines(file);
+  const std::vector<std::string> phases{"reading the model", "choosing layers", "planning bevels", "measuring deviation",
+                                        "writing the stack", "nesting and programs", "writing sheets", "done"};
+  ASSERT_EQ(lines.size(), phases.size()) << slurp(file);
+  for (std::size_t i = 0; i < phases.size(); ++i) {
+    EXPECT_EQ(lines[i]["phase"], phases[i]);
+    EXPECT_EQ(lines[i]["step"], std::min<int>(static_cast<int>(i) + 1, 7));
+    EXPECT_EQ(lines[i]["steps"], 7);
+  }
+  // Without programs there are five phases; a failed plan stops before "done".
+  const auto stack_only = lamina("plan " + quoted(kKnob) + " --no-programs --out " + quoted(out.path / "stack") +
+                                 " --progress-fd 3 3>" + quoted(file));
+  ASSERT_EQ(stack_only.exit_code, 0) << stack_only.out;
+  EXPECT_EQ(progress_lines(file).size(), 6u);
+  EXPECT_EQ(progress_lines(file).back()["steps"], 5);
+  const auto broken = lamina("plan " + quoted(out.path / "missing.stl") + " --out " + quoted(out.path / "x") +
+                             " --progress-fd 3 3>" + quoted(file));
+  EXPECT_NE(broken.exit_code, 0);
+  const auto failed = progress_lines(file);
+  ASSERT_FALSE(failed.empty());
+  EXPECT_NE(failed.back()["phase"], "done");
 }
 
 TEST(CliSheets, NoProgramsStopsAfterTheStack) {

@@ -63,6 +63,9 @@ struct JobRecord {
   nlohmann::json summary = nlohmann::json::object();  // from the plan report: layers, sheets, lines, deviation…
   std::int64_t created_unix_ms = 0;
   std::int64_t updated_unix_ms = 0;
+  // While planning: the planner's last phase {phase, step, steps}. Not stored: a restart plans
+  // the job again from the start.
+  nlohmann::json planning = nullptr;
 };
 
 struct JobEvent {
