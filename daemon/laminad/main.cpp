@@ -102,6 +102,9 @@ int run(const fs::path& config_path, bool check_only) {
   }
 
   boost::asio::io_context io;
+  // Caught from here on: a SIGTERM during start-up (systemd stopping a unit it just started) is
+  // queued until the handler below is waiting, not the default action that kills us mid-write.
+  boost::asio::signal_set signals(io, SIGTERM, SIGINT);
   RpcServerSettings rs;
   rs.unix_path = config->server.socket_path;
   rs.unix_mode = config->server.socket_mode;
@@ -156,7 +159,6 @@ int run(const fs::path& config_path, bool check_only) {
   }
 
   std::thread stopper;  // winds the jobs down off the io thread, which keeps pinging the watchdog
-  boost::asio::signal_set signals(io, SIGTERM, SIGINT);
   signals.async_wait([&](const boost::system::error_code& ec, int signal) {
     if (ec) return;
     spdlog::info("{}: stopping (machine held, cell made safe, jobs saved)", signal == SIGTERM ? "SIGTERM" : "SIGINT");

@@ -158,6 +158,20 @@ TEST(LaminadProtocol, UploadedModelIsPlanned) {
   EXPECT_EQ(wait_state(c, job["id"], "waiting_sheet", 120)["state"], "waiting_sheet");
 }
 
+// systemd may stop a unit the moment it started. Once the socket exists the daemon handles
+// SIGTERM itself (a clean exit 0), never the default action that kills it mid-start.
+TEST(LaminadProtocol, ASigtermRightAfterTheSocketAppearsIsACleanStop) {
+  Cell cell;
+  for (int round = 0; round < 5; ++round) {
+    Laminad daemon(cell.config(), cell.dir.file(""));
+    const auto t0 = std::chrono::steady_clock::now();
+    while (!std::filesystem::exists(cell.socket()) && seconds_since(t0) < 20)
+      std::this_thread::sleep_for(std::chrono::microseconds(100));
+    ASSERT_TRUE(std::filesystem::exists(cell.socket()));
+    EXPECT_EQ(daemon.stop(SIGTERM), 0) << "round " << round << "\n" << daemon.log();
+  }
+}
+
 // sd_notify: READY=1 once the socket listens, STOPPING=1 on SIGTERM (NOTIFY_SOCKET pointed at a
 // datagram socket of the test, as systemd would).
 TEST(LaminadProtocol, TellsSystemdWhenReadyAndWhenStopping) {
