@@ -215,16 +215,26 @@ TEST(CellIo, JetOffFromAnotherThreadClosesTheJet) {
   EXPECT_EQ(plc.coil(map::kCoilPump), 1) << "jet_off touches the jet only";
 }
 
+// A drip-fed program running on the simulated CNC (20 moves of 1 s), the PLC watching it.
+struct RunningDripFeed {
+  SimCell cell{{"--personality", "xonxoff", "--time-scale", "1"}};
+  PlcProbe plc{cell.sim.modbus_port()};
+  sim::testing::StreamClient client = sim::testing::StreamClient::open_pty(cell.dir.file("cnc"));
+  // False unless the program went out and the PLC reads the CNC running.
+  bool start() {
+    std::string program = "%\n";
+    for (int i = 0; i < 20; ++i) program += fmt::format("G1X{}F600\n", 10 * (i % 2));
+    return client.send(program) && eventually([&] { return plc.in_reg(map::kInCncState) == 1; }, 3.0);
+  }
+};
+
 // A drip-fed program is running, held by the PLC's button, then reset by its other button: the
 // CNC's queue is gone and it reads idle when reset_cnc() returns.
 TEST(CellIo, ResetCncFlushesAHeldProgramAndReturnsWhenTheCncIsIdle) {
-  SimCell cell({"--personality", "xonxoff", "--time-scale", "1"});
-  PlcProbe plc(cell.sim.modbus_port());
-  auto client = sim::testing::StreamClient::open_pty(cell.dir.file("cnc"));
-  std::string program = "%\n";
-  for (int i = 0; i < 20; ++i) program += fmt::format("G1X{}F600\n", 10 * (i % 2));
-  ASSERT_TRUE(client.send(program));
-  ASSERT_TRUE(eventually([&] { return plc.in_reg(map::kInCncState) == 1; }, 3.0)) << "running";
+  RunningDripFeed feed;
+  ASSERT_TRUE(feed.start()) << "running";
+  SimCell& cell = feed.cell;
+  PlcProbe& plc = feed.plc;
   CellIo io(settings_for(cell.sim.modbus_port()));
   io.feed_hold();
   ASSERT_TRUE(eventually([&] { return plc.in_reg(map::kInCncState) == 3; }, 3.0)) << "held";
@@ -239,13 +249,10 @@ TEST(CellIo, ResetCncFlushesAHeldProgramAndReturnsWhenTheCncIsIdle) {
 // hold_cnc() returns only once the PLC has handed the press on: the CNC reads held at once,
 // so a reset over the line that follows cannot be overtaken by a late hold.
 TEST(CellIo, HoldCncReturnsOnceTheCncIsHeld) {
-  SimCell cell({"--personality", "xonxoff", "--time-scale", "1"});
-  PlcProbe plc(cell.sim.modbus_port());
-  auto client = sim::testing::StreamClient::open_pty(cell.dir.file("cnc"));
-  std::string program = "%\n";
-  for (int i = 0; i < 20; ++i) program += fmt::format("G1X{}F600\n", 10 * (i % 2));
-  ASSERT_TRUE(client.send(program));
-  ASSERT_TRUE(eventually([&] { return plc.in_reg(map::kInCncState) == 1; }, 3.0)) << "running";
+  RunningDripFeed feed;
+  ASSERT_TRUE(feed.start()) << "running";
+  SimCell& cell = feed.cell;
+  PlcProbe& plc = feed.plc;
   CellIo io(settings_for(cell.sim.modbus_port()));
   const auto r = io.hold_cnc();
   ASSERT_TRUE(r) << r.error().message;
