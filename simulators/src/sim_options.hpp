@@ -25,6 +25,15 @@ struct FaultSchedule {
   std::uint64_t garble_seed = 1;
 };
 
+// What the controller does when a client opens its port. Boards differ, and a host must cope
+// with each: a classic Grbl on an Arduino reboots when DTR rises (motion stops, queue lost,
+// banner); a controller on native USB or Ethernet does not notice the open at all.
+enum class OnOpen {
+  banner,  // the banner, nothing else changes (the default: a host sees the controller is there)
+  reset,   // a reset as DTR gives a classic Grbl: motion stops, queue and buffer flushed, banner
+  quiet,   // nothing: the controller keeps running and says nothing until asked
+};
+
 struct SimOptions {
   std::string personality = "grbl";  // grbl | xonxoff
   std::string link_path;             // PTY symlink
@@ -34,6 +43,7 @@ struct SimOptions {
   std::string log_path;
   double baud = 115200;
   double time_scale = 1;
+  OnOpen on_open = OnOpen::banner;
   MachineConfig machine;
   GrblParams grbl;
   XonXoffParams xonxoff;

@@ -45,6 +45,15 @@ int state_code(MachineState s) {  // as the PLC's cnc_state register (docs/modbu
   return 0;
 }
 
+const char* on_open_name(OnOpen o) {
+  switch (o) {
+    case OnOpen::banner: return "banner";
+    case OnOpen::reset: return "reset";
+    case OnOpen::quiet: return "quiet";
+  }
+  return "?";
+}
+
 }  // namespace
 
 SimRuntime::SimRuntime(SimOptions options)
@@ -80,6 +89,7 @@ SimRuntime::SimRuntime(SimOptions options)
   // Power-up: the controller prints its banner even before anyone listens (grblHAL does).
   protocol_->on_connect(0.0);
   log_.write_event("start", 0.0, {{"personality", options_.personality}, {"port", port_->describe()},
+                                  {"on_open", on_open_name(options_.on_open)},
                                   {"baud", options_.baud}, {"time_scale", options_.time_scale}});
 }
 
@@ -119,9 +129,16 @@ void SimRuntime::step() {
 
   switch (port_->update()) {
     case PortChange::client_connected:
-      log_.write_event("connect", now);
+      log_.write_event("connect", now, {{"on_open", on_open_name(options_.on_open)}});
       tx_pending_.clear();
-      protocol_->on_connect(now);
+      switch (options_.on_open) {
+        case OnOpen::banner: protocol_->on_connect(now); break;
+        case OnOpen::reset:  // the reset prints the banner itself (after ALARM:3 if it was moving)
+          protocol_->external_reset(now);
+          log_.write_event("reset", now, {{"source", "open"}});
+          break;
+        case OnOpen::quiet: break;
+      }
       break;
     case PortChange::client_gone:
       log_.write_event("disconnect", now);

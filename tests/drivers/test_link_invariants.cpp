@@ -25,6 +25,23 @@ TEST(LinkInvariants, GrblCharacterCountingDeliversEveryLineOnceInOrder) {
   expect_log_equals_program(dir.file("exec.jsonl"), program);
 }
 
+// Boards greet differently when the port opens (lamina-sim --on-open): a banner, a DTR reset
+// followed by the banner, or nothing at all (native USB). The handshake must not depend on it.
+TEST(LinkInvariants, GrblHandshakeWorksWhateverTheBoardDoesWhenThePortOpens) {
+  for (const std::string on_open : {"banner", "reset", "quiet"}) {
+    SCOPED_TRACE("--on-open " + on_open);
+    TempDir dir;
+    const auto program = contour_program(2, 60);
+    SimProcess sim({"--link", dir.file("cnc"), "--log", dir.file("exec.jsonl"), "--time-scale", "20",
+                    "--on-open", on_open});
+    const CliRun run = run_lamina_stream(fmt::format("'{}' --port '{}' --protocol grbl",
+                                                     write_program(dir, program), dir.file("cnc")));
+    ASSERT_EQ(run.exit_code, 0) << run.output;
+    EXPECT_EQ(run.summary["state"], "completed");
+    expect_log_equals_program(dir.file("exec.jsonl"), program);
+  }
+}
+
 TEST(LinkInvariants, SendResponseDeliversEveryLineOnceInOrder) {
   TempDir dir;
   const auto program = contour_program(2, 60);

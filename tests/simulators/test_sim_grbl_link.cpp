@@ -3,6 +3,7 @@
 // the error lock.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <regex>
 
 #include "grbl_client.hpp"
@@ -227,12 +228,6 @@ TEST(SimGrblLink, RefusesANonLoopbackAddressAndABadMachineFile) {
   EXPECT_FALSE(std::filesystem::exists(dir.file("cnc"))) << "nothing left behind";
 }
 
-}  // namespace
-}  // namespace lamina::sim::testing
-
-namespace lamina::sim::testing {
-namespace {
-
 TEST(SimGrblLink, StarvationIsLoggedWhenTheSenderFallsBehindAndNotWhenItKeepsUp) {
   // Keeping up: 0.5 mm moves at 1800 mm/min (17 ms each) over a 115200-baud line, counted.
   {
@@ -271,6 +266,67 @@ TEST(SimGrblLink, UnplugAtTimeDropsTheLinkWhileTheMachineFinishesItsQueue) {
   EXPECT_FALSE(std::filesystem::exists(s.link)) << "the device node is gone, as an unplugged USB adapter's";
   ASSERT_TRUE(wait_status(s.sim.control_port(), [](const nlohmann::json& st) { return st["state"] == "idle"; }, 3));
   EXPECT_NEAR(control_status(s.sim.control_port())["position"][0].get<double>(), 100, 1e-6);
+}
+
+
+// What a board does when the host opens its port (--on-open). The driver must cope with each:
+// a classic Grbl that DTR resets (the program in flight is lost: ALARM:3, then the banner), a
+// controller that only greets, and a native-USB one that says nothing and keeps running.
+struct ReopenedWhileMoving {
+  std::string said_on_reopen;  // what came on the line in the first 0.7 s after the second open
+  nlohmann::json status;       // the control socket's status right after
+  std::vector<nlohmann::json> log;
+};
+
+ReopenedWhileMoving reopen_while_moving(const std::string& on_open) {
+  PtySim s({"--on-open", on_open});
+  {
+    StreamClient c = StreamClient::open_pty(s.link);
+    c.read_until([](const std::string&) { return false; }, 0.3);  // whatever the open brings
+    c.send("G1X300F600\n");                                        // 30 s of motion
+    EXPECT_TRUE(c.wait_for("ok", 2.0)) << on_open << ": " << c.buffer();
+    EXPECT_TRUE(wait_status(s.sim.control_port(), [](const nlohmann::json& st) { return st["state"] == "run"; }, 3));
+  }  // the host closes the port (a crash, a restart)
+  EXPECT_TRUE(wait_status(s.sim.control_port(), [](const nlohmann::json& st) { return st["client_present"] == false; }, 3));
+  StreamClient again = StreamClient::open_pty(s.link);
+  again.read_until([](const std::string&) { return false; }, 0.7);
+  ReopenedWhileMoving r{again.buffer(), control_status(s.sim.control_port()), {}};
+  r.log = read_log(s.log);
+  return r;
+}
+
+std::size_t events_named(const std::vector<nlohmann::json>& log, const std::string& name) {
+  return static_cast<std::size_t>(std::count_if(log.begin(), log.end(), [&](const nlohmann::json& r) {
+    return r.value("event", "") == name;
+  }));
+}
+
+TEST(SimGrblLink, OnOpenBannerGreetsAndLeavesTheMachineRunning) {
+  const auto r = reopen_while_moving("banner");
+  EXPECT_NE(r.said_on_reopen.find("Grbl"), std::string::npos) << r.said_on_reopen;
+  EXPECT_EQ(r.said_on_reopen.find("ALARM"), std::string::npos) << r.said_on_reopen;
+  EXPECT_EQ(r.status["state"], "run");
+  EXPECT_EQ(events_named(r.log, "reset"), 0u);
+}
+
+TEST(SimGrblLink, OnOpenResetStopsTheMachineAsADtrResetDoes) {
+  const auto r = reopen_while_moving("reset");
+  const auto alarm = r.said_on_reopen.find("ALARM:3");
+  ASSERT_NE(alarm, std::string::npos) << "reset while moving: " << r.said_on_reopen;
+  EXPECT_NE(r.said_on_reopen.find("Grbl", alarm), std::string::npos) << "banner after the alarm: " << r.said_on_reopen;
+  EXPECT_EQ(r.status["state"], "alarm");
+  EXPECT_EQ(r.status["queued_blocks"], 0) << "the queue is lost with the reset";
+  const double x = r.status["position"][0].get<double>();
+  EXPECT_GT(x, 0);
+  EXPECT_LT(x, 300) << "stopped where it was, not at the target";
+  EXPECT_EQ(events_named(r.log, "reset"), 2u) << "one per open";
+}
+
+TEST(SimGrblLink, OnOpenQuietSaysNothingAndKeepsRunning) {
+  const auto r = reopen_while_moving("quiet");
+  EXPECT_EQ(r.said_on_reopen, "") << "a native-USB controller does not see the port open";
+  EXPECT_EQ(r.status["state"], "run");
+  EXPECT_EQ(events_named(r.log, "reset"), 0u);
 }
 
 }  // namespace
