@@ -3,6 +3,8 @@
 // SIGTERM while cutting holds the machine, leaves the jet off and the job interrupted.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "daemon_fixture.hpp"
 
 namespace lamina::daemon::testing {
@@ -22,8 +24,38 @@ std::string start_cutting(RpcClient& c, Cell& cell, std::size_t blocks_before) {
   return id;
 }
 
-TEST(LaminadRecovery, KilledWhileCuttingComesBackInterruptedAndResumesOnRequest) {
-  Cell cell({}, 40);
+// The first run is the program's prefix; the resumed run starts at the contour that was being
+// cut when the daemon died: no finished contour runs twice, nothing is skipped.
+void expect_resumed_at_the_cut_short_contour(const std::vector<std::string>& lines, const std::vector<LogBlock>& ran_before,
+                                             const std::vector<LogBlock>& log) {
+  std::size_t done = 0;
+  while (done < ran_before.size() && ran_before[done].line == lines[done]) ++done;
+  ASSERT_EQ(done, ran_before.size()) << "the first run is the program in order";
+  std::size_t finished = 0;  // lines that completed in the first run
+  for (std::size_t i = 0; i < ran_before.size(); ++i)
+    if (ran_before[i].completed) finished = i + 1;
+  std::size_t contour_start = 0;
+  for (std::size_t k = 0; k <= std::min(finished, lines.size() - 1); ++k)
+    if (lines[k].rfind("(CONTOUR ", 0) == 0) contour_start = k;
+  std::size_t resumed_at = log.size();
+  for (std::size_t i = ran_before.size(); i < log.size(); ++i)
+    if (log[i].line == lines[contour_start]) {
+      resumed_at = i;
+      break;
+    }
+  ASSERT_LT(resumed_at, log.size()) << "the resumed run starts at contour line " << contour_start + 1;
+  ASSERT_EQ(log.size() - resumed_at, lines.size() - contour_start);
+  for (std::size_t i = 0; i < lines.size() - contour_start; ++i)
+    ASSERT_EQ(log[resumed_at + i].line, lines[contour_start + i]) << "resumed block " << i + 1;
+}
+
+// What the board does when a host opens its port (lamina-sim --on-open): greets, or reboots as
+// a classic Grbl does on DTR. The daemon opens the port only to cut, so on a resetting board
+// the resume's open resets the machine again before the resumed program: it must still work.
+class LaminadRecovery : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(LaminadRecovery, KilledWhileCuttingComesBackInterruptedAndResumesOnRequest) {
+  Cell cell({"--on-open", GetParam()}, 40);
   auto daemon = std::make_unique<Laminad>(cell.config(), cell.dir.file(""));
   std::string id;
   {
@@ -54,32 +86,17 @@ TEST(LaminadRecovery, KilledWhileCuttingComesBackInterruptedAndResumesOnRequest)
   job = wait_job(c, id, [](const Json& j) { return j["state"] == "completed" || j["state"] == "paused" || j["state"] == "failed"; }, 300);
   ASSERT_EQ(job["state"], "completed") << job.dump(2) << daemon->log();
 
-  // The first run is the program's prefix; the resumed run starts at the contour that was being
-  // cut when the daemon died: no finished contour runs twice, nothing is skipped.
-  const auto lines = program_lines(job["sheets"][0]["program"]);
-  const auto log = executed(cell.log());
-  std::size_t done = 0;
-  while (done < ran_before.size() && ran_before[done].line == lines[done]) ++done;
-  ASSERT_EQ(done, ran_before.size()) << "the first run is the program in order";
-  std::size_t finished = 0;  // lines that completed in the first run
-  for (std::size_t i = 0; i < ran_before.size(); ++i)
-    if (ran_before[i].completed) finished = i + 1;
-  std::size_t contour_start = 0;
-  for (std::size_t k = 0; k <= std::min(finished, lines.size() - 1); ++k)
-    if (lines[k].rfind("(CONTOUR ", 0) == 0) contour_start = k;
-  std::size_t resumed_at = log.size();
-  for (std::size_t i = ran_before.size(); i < log.size(); ++i)
-    if (log[i].line == lines[contour_start]) {
-      resumed_at = i;
-      break;
-    }
-  ASSERT_LT(resumed_at, log.size()) << "the resumed run starts at contour line " << contour_start + 1;
-  ASSERT_EQ(log.size() - resumed_at, lines.size() - contour_start);
-  for (std::size_t i = 0; i < lines.size() - contour_start; ++i)
-    ASSERT_EQ(log[resumed_at + i].line, lines[contour_start + i]) << "resumed block " << i + 1;
+  expect_resumed_at_the_cut_short_contour(program_lines(job["sheets"][0]["program"]), ran_before, executed(cell.log()));
+  const auto records = sim::testing::read_log(cell.log());
+  const auto count = [&](const std::string& event) {
+    return std::count_if(records.begin(), records.end(), [&](const Json& r) { return r.value("event", "") == event; });
+  };
+  EXPECT_EQ(count("reset"), GetParam() == "reset" ? count("connect") : 0) << "a reset on every open, or none";
 }
 
-TEST(LaminadRecovery, SigtermWhileCuttingLeavesTheCellSafeAndTheJobInterrupted) {
+INSTANTIATE_TEST_SUITE_P(OnOpen, LaminadRecovery, ::testing::Values("banner", "reset"));
+
+TEST(LaminadShutdown, SigtermWhileCuttingLeavesTheCellSafeAndTheJobInterrupted) {
   Cell cell({}, 40);
   Laminad daemon(cell.config(), cell.dir.file(""));
   std::string id;

@@ -25,21 +25,26 @@ TEST(LinkInvariants, GrblCharacterCountingDeliversEveryLineOnceInOrder) {
   expect_log_equals_program(dir.file("exec.jsonl"), program);
 }
 
-// Boards greet differently when the port opens (lamina-sim --on-open): a banner, a DTR reset
-// followed by the banner, or nothing at all (native USB). The handshake must not depend on it.
-TEST(LinkInvariants, GrblHandshakeWorksWhateverTheBoardDoesWhenThePortOpens) {
-  for (const std::string on_open : {"banner", "reset", "quiet"}) {
-    SCOPED_TRACE("--on-open " + on_open);
-    TempDir dir;
-    const auto program = contour_program(2, 60);
-    SimProcess sim({"--link", dir.file("cnc"), "--log", dir.file("exec.jsonl"), "--time-scale", "20",
-                    "--on-open", on_open});
-    const CliRun run = run_lamina_stream(fmt::format("'{}' --port '{}' --protocol grbl",
-                                                     write_program(dir, program), dir.file("cnc")));
-    ASSERT_EQ(run.exit_code, 0) << run.output;
-    EXPECT_EQ(run.summary["state"], "completed");
-    expect_log_equals_program(dir.file("exec.jsonl"), program);
-  }
+// Boards greet differently when the port opens (lamina-sim --on-open): a banner (a drip feed's
+// DC1), a DTR reset followed by the banner (DC3 SYN DC1 for a drip feed), or nothing at all
+// (native USB). Neither protocol's start may depend on it.
+TEST(LinkInvariants, TheStartWorksWhateverTheBoardDoesWhenThePortOpens) {
+  for (const std::string protocol : {"grbl", "xonxoff"})
+    for (const std::string on_open : {"banner", "reset", "quiet"}) {
+      SCOPED_TRACE(protocol + " --on-open " + on_open);
+      TempDir dir;
+      const auto program = contour_program(2, 40);
+      SimProcess sim({"--personality", protocol, "--link", dir.file("cnc"), "--log", dir.file("exec.jsonl"),
+                      "--time-scale", "20", "--control", "127.0.0.1:0", "--on-open", on_open});
+      const CliRun run = run_lamina_stream(fmt::format("'{}' --port '{}' --protocol {}", write_program(dir, program),
+                                                       dir.file("cnc"), protocol));
+      ASSERT_EQ(run.exit_code, 0) << run.output;
+      EXPECT_EQ(run.summary["state"], "completed");
+      ASSERT_TRUE(sim::testing::wait_status(sim.control_port(), [&](const nlohmann::json& st) {
+        return st["executed_blocks"] == program.size();
+      }, 30));
+      expect_log_equals_program(dir.file("exec.jsonl"), program);
+    }
 }
 
 TEST(LinkInvariants, SendResponseDeliversEveryLineOnceInOrder) {
