@@ -39,13 +39,9 @@ struct StreamOptions {
 };
 
 std::pair<std::string, int> split_host_port(const std::string& text, const char* flag) {
-  const auto colon = text.rfind(':');
-  if (colon == std::string::npos) throw CLI::ValidationError(flag, fmt::format("'{}': expected HOST:PORT", text));
-  try {
-    return {text.substr(0, colon), std::stoi(text.substr(colon + 1))};
-  } catch (const std::exception&) {
-    throw CLI::ValidationError(flag, fmt::format("'{}': the port is not a number", text));
-  }
+  auto hp = drivers::parse_host_port(text);
+  if (!hp) throw CLI::ValidationError(flag, fmt::format("'{}': expected HOST:PORT (\"[::1]:PORT\" for IPv6)", text));
+  return *hp;
 }
 
 std::expected<std::vector<std::string>, std::string> read_program(const std::string& path) {
@@ -80,12 +76,11 @@ int run_stream(const StreamOptions& o) {
       return 2;
     }
     drivers::ModbusBlockSettings s;
-    std::tie(s.host, s.port) = split_host_port(o.modbus, "--modbus");
+    std::tie(s.plc.host, s.plc.port) = split_host_port(o.modbus, "--modbus");
     s.status_period_s = 1.0 / o.status_hz;
     link = std::make_unique<drivers::ModbusBlockLink>(s);
     drivers::CellIoSettings cs;  // the same PLC minds the pump and interlocks
-    cs.host = s.host;
-    cs.port = s.port;
+    cs.plc = s.plc;
     cell = std::make_unique<drivers::CellIo>(cs);
   } else {
     if (o.port.empty() == o.tcp.empty()) {
@@ -112,7 +107,7 @@ int run_stream(const StreamOptions& o) {
     link = std::make_unique<drivers::Streamer>(std::move(open), std::move(protocol), settings);
     if (!o.modbus.empty()) {
       drivers::CellIoSettings cs;
-      std::tie(cs.host, cs.port) = split_host_port(o.modbus, "--modbus");
+      std::tie(cs.plc.host, cs.plc.port) = split_host_port(o.modbus, "--modbus");
       cell = std::make_unique<drivers::CellIo>(cs);
     }
   }

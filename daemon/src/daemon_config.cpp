@@ -1,5 +1,7 @@
 #include "lamina/daemon/daemon_config.hpp"
 
+#include "lamina/drivers/modbus_endpoint.hpp"
+
 #include <fmt/format.h>
 #include <sys/un.h>
 #include <toml++/toml.h>
@@ -43,26 +45,6 @@ std::expected<std::string, std::string> read_file(const fs::path& file) {
   text << in.rdbuf();
   if (in.bad()) return std::unexpected(fmt::format("cannot read {}", file.string()));
   return text.str();
-}
-
-// HOST:PORT (an IPv6 host in brackets, "[::1]:7400"), or nothing when malformed.
-std::optional<std::pair<std::string, int>> split_host_port(std::string_view text) {
-  const auto colon = text.rfind(':');
-  if (colon == std::string_view::npos) return std::nullopt;
-  std::string_view host = text.substr(0, colon);
-  const std::string_view port = text.substr(colon + 1);
-  if (host.size() >= 2 && host.front() == '[' && host.back() == ']') host = host.substr(1, host.size() - 2);
-  else if (host.find(':') != std::string_view::npos) return std::nullopt;  // IPv6 needs its brackets
-  if (host.empty() || port.empty() || port.size() > 5) return std::nullopt;
-  for (const char c : host)
-    if (c == ' ' || c == '\t' || c == '[' || c == ']' || c == '/') return std::nullopt;
-  int value = 0;
-  for (const char c : port) {
-    if (c < '0' || c > '9') return std::nullopt;
-    value = value * 10 + (c - '0');
-  }
-  if (value < 1 || value > 65535) return std::nullopt;
-  return std::pair{std::string(host), value};
 }
 
 std::string trim(std::string_view s) {
@@ -176,7 +158,7 @@ class Section {
   void host_port(std::string_view key, std::string& out) {
     std::string text = out;
     if (!string(key, text) || !node(key)) return;
-    if (!text.empty() && !split_host_port(text)) return fail(key, "expected \"HOST:PORT\" (\"[::1]:PORT\" for IPv6)");
+    if (!text.empty() && !drivers::parse_host_port(text)) return fail(key, "expected \"HOST:PORT\" (\"[::1]:PORT\" for IPv6)");
     out = text;
   }
 
@@ -191,7 +173,8 @@ constexpr std::array kSections{"server"sv, "link"sv, "cell"sv, "planner"sv};
 constexpr std::array kServerKeys{"socket"sv, "socket_mode"sv, "socket_group"sv, "tcp"sv, "token"sv, "token_file"sv,
                                  "max_request_bytes"sv};
 constexpr std::array kLinkKeys{"protocol"sv, "port"sv, "tcp"sv, "baud"sv, "rx_buffer"sv, "status_hz"sv};
-constexpr std::array kCellKeys{"enabled"sv, "modbus"sv, "heartbeat_period_s"sv, "pump_ready_timeout_s"sv,
+constexpr std::array kCellKeys{"enabled"sv, "modbus"sv, "modbus_unit"sv, "modbus_timeout_s"sv,
+                               "modbus_reconnects"sv, "heartbeat_period_s"sv, "pump_ready_timeout_s"sv,
                                "pressure_setpoint_mpa"sv, "abrasive_g_per_min"sv};
 constexpr std::array kPlannerKeys{"lamina"sv, "workers"sv, "machine"sv, "materials"sv, "timeout_s"sv};
 constexpr std::array kProtocols{"grbl"sv, "send-response"sv, "xonxoff"sv, "modbus"sv};
@@ -240,7 +223,7 @@ void read_server(Section s, ServerConfig& c) {
 
   std::string tcp;
   s.host_port("tcp", tcp);
-  if (const auto hp = split_host_port(tcp)) {
+  if (const auto hp = drivers::parse_host_port(tcp)) {
     c.tcp_host = hp->first;
     c.tcp_port = hp->second;
   }
@@ -267,6 +250,9 @@ void read_cell(Section s, CellConfig& c) {
   s.boolean("enabled", c.enabled);
   s.host_port("modbus", c.modbus);
   if (c.enabled && c.modbus.empty()) s.fail("modbus", "the PLC's address \"HOST:PORT\" is needed when enabled = true");
+  s.integer("modbus_unit", c.modbus_unit, 0, 255);  // Modbus TCP: 1…247, 0 and 255 for a PLC that ignores it
+  s.number("modbus_timeout_s", c.modbus_timeout_s, {0.01, 10});
+  s.integer("modbus_reconnects", c.modbus_reconnects, 0, 100);
   s.number("heartbeat_period_s", c.heartbeat_period_s, {0.01, 10});
   s.number("pump_ready_timeout_s", c.pump_ready_timeout_s, {0, 600, true});
   // The PLC takes the set point in 0.1 MPa in a 16-bit register; real pumps stop well below.

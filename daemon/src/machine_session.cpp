@@ -6,19 +6,26 @@
 #include <fmt/format.h>
 
 #include "lamina/drivers/modbus_block_link.hpp"
+#include "lamina/drivers/modbus_endpoint.hpp"
 #include "lamina/drivers/streamer.hpp"
 
 namespace lamina::daemon {
 namespace {
 
 std::pair<std::string, int> host_port(const std::string& text, const char* what) {
-  const auto colon = text.rfind(':');
-  if (colon == std::string::npos || colon == 0) throw std::invalid_argument(fmt::format("{} '{}': expected HOST:PORT", what, text));
-  try {
-    return {text.substr(0, colon), std::stoi(text.substr(colon + 1))};
-  } catch (const std::exception&) {
-    throw std::invalid_argument(fmt::format("{} '{}': the port is not a number", what, text));
-  }
+  auto hp = drivers::parse_host_port(text);
+  if (!hp) throw std::invalid_argument(fmt::format("{} '{}': expected HOST:PORT", what, text));
+  return *hp;
+}
+
+// The cell's PLC, described once for both of its users (the mailbox link and CellIo).
+drivers::ModbusEndpoint plc_endpoint(const CellConfig& c) {
+  drivers::ModbusEndpoint e;
+  std::tie(e.host, e.port) = host_port(c.modbus, "[cell] modbus");
+  e.unit_id = c.modbus_unit;
+  e.response_timeout_s = c.modbus_timeout_s;
+  e.max_reconnects = c.modbus_reconnects;
+  return e;
 }
 
 nlohmann::json position_json(const std::optional<std::array<double, 5>>& p) {
@@ -32,7 +39,7 @@ MachineSession::MachineSession(const DaemonConfig& config) : link_config_(config
   const MachineLinkConfig& l = config.link;
   if (l.protocol == "modbus") {
     drivers::ModbusBlockSettings s;
-    std::tie(s.host, s.port) = host_port(config.cell.modbus, "[cell] modbus");
+    s.plc = plc_endpoint(config.cell);
     s.status_period_s = 1.0 / l.status_hz;
     link_ = std::make_unique<drivers::ModbusBlockLink>(s);
     describe_ = fmt::format("Modbus mailbox on {}", config.cell.modbus);
@@ -60,7 +67,7 @@ MachineSession::MachineSession(const DaemonConfig& config) : link_config_(config
   }
   if (config.cell.enabled) {
     drivers::CellIoSettings cs;
-    std::tie(cs.host, cs.port) = host_port(config.cell.modbus, "[cell] modbus");
+    cs.plc = plc_endpoint(config.cell);
     cs.heartbeat_period_s = config.cell.heartbeat_period_s;
     cs.pump_ready_timeout_s = config.cell.pump_ready_timeout_s;
     cs.pressure_setpoint_01mpa = static_cast<std::uint16_t>(config.cell.pressure_setpoint_mpa * 10 + 0.5);

@@ -40,9 +40,7 @@ struct CellIo::Impl {
   explicit Impl(CellIoSettings s)
       : settings(std::move(s)),
         log(driver_logger("cell")),
-        client(ModbusTarget{settings.host, settings.port, settings.unit_id, settings.response_timeout_s,
-                            settings.max_reconnects},
-               log) {
+        client(settings.plc, log) {
     client.set_abort([this] { return stopping.load(); });
     thread = std::thread([this] { run(); });
   }

@@ -30,9 +30,7 @@ struct ModbusBlockLink::Impl {
   explicit Impl(ModbusBlockSettings s)
       : settings(std::move(s)),
         log(driver_logger("modbus-link")),
-        client(ModbusTarget{settings.host, settings.port, settings.unit_id, settings.response_timeout_s,
-                            settings.max_reconnects},
-               log) {
+        client(settings.plc, log) {
     client.set_abort([this] { return shutting_down.load() || stop_requested.load(); });
     thread = std::thread([this] { run(); });
   }

@@ -1,5 +1,8 @@
 #include "modbus_client.hpp"
 
+#include <netdb.h>
+#include <sys/socket.h>
+
 #include <modbus/modbus.h>
 
 #include <cerrno>
@@ -27,7 +30,7 @@ std::shared_ptr<spdlog::logger> driver_logger(const std::string& name) {
   return spdlog::stderr_color_mt(name);
 }
 
-ModbusClient::ModbusClient(ModbusTarget target, std::shared_ptr<spdlog::logger> log)
+ModbusClient::ModbusClient(ModbusEndpoint target, std::shared_ptr<spdlog::logger> log)
     : target_(std::move(target)), log_(std::move(log)) {}
 
 ModbusClient::~ModbusClient() { close(); }
@@ -43,9 +46,12 @@ void ModbusClient::close() {
 
 bool ModbusClient::connect_once(std::string& error) {
   close();
-  ctx_ = modbus_new_tcp(target_.host.c_str(), target_.port);
+  // The _pi variant resolves names and IPv6 ("plc-cell1", "fd00::7"); modbus_new_tcp takes
+  // IPv4 dotted quads only and would fail a shop's PLC host name at connect time.
+  const std::string service = std::to_string(target_.port);
+  ctx_ = modbus_new_tcp_pi(target_.host.c_str(), service.c_str());
   if (!ctx_) {
-    error = fmt::format("modbus_new_tcp: {}", modbus_strerror(errno));
+    error = fmt::format("modbus_new_tcp_pi: {}", modbus_strerror(errno));
     return false;
   }
   const double t = std::max(0.001, target_.response_timeout_s);
@@ -55,7 +61,18 @@ bool ModbusClient::connect_once(std::string& error) {
   modbus_set_response_timeout(ctx_, sec, usec);
   modbus_set_slave(ctx_, target_.unit_id);
   if (modbus_connect(ctx_) != 0) {
-    error = modbus_strerror(errno);
+    const int connect_errno = errno;
+    error = modbus_strerror(connect_errno);
+    // libmodbus reports a name that does not resolve as ECONNREFUSED: say what really happened.
+    if (connect_errno == ECONNREFUSED) {
+      addrinfo hints{};
+      hints.ai_socktype = SOCK_STREAM;
+      addrinfo* found = nullptr;
+      if (const int gai = ::getaddrinfo(target_.host.c_str(), service.c_str(), &hints, &found); gai != 0)
+        error = fmt::format("cannot resolve '{}' ({})", target_.host, ::gai_strerror(gai));
+      else
+        ::freeaddrinfo(found);
+    }
     close();
     return false;
   }

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "lamina/drivers/link_error.hpp"
+#include "lamina/drivers/modbus_endpoint.hpp"
 
 struct _modbus;  // libmodbus's modbus_t; its header stays in the .cpp
 
@@ -25,21 +26,13 @@ class logger;
 
 namespace lamina::drivers {
 
-struct ModbusTarget {
-  std::string host;
-  int port = 502;
-  int unit_id = 1;
-  double response_timeout_s = 0.5;
-  int max_reconnects = 3;
-  double backoff_s = 0.05;  // before reconnect k: k × this
-};
 
 // Named logger shared by every instance ("cell", "modbus-link"), created on first use.
 std::shared_ptr<spdlog::logger> driver_logger(const std::string& name);
 
 class ModbusClient {
  public:
-  ModbusClient(ModbusTarget target, std::shared_ptr<spdlog::logger> log);
+  ModbusClient(ModbusEndpoint target, std::shared_ptr<spdlog::logger> log);
   ~ModbusClient();
   ModbusClient(const ModbusClient&) = delete;
   ModbusClient& operator=(const ModbusClient&) = delete;
@@ -64,7 +57,7 @@ class ModbusClient {
   std::expected<void, LinkError> call(const std::string& what, const std::function<int(_modbus*)>& op);
   bool connect_once(std::string& error);
 
-  ModbusTarget target_;
+  ModbusEndpoint target_;
   std::shared_ptr<spdlog::logger> log_;
   _modbus* ctx_ = nullptr;
   int reconnects_ = 0;

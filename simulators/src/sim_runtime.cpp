@@ -185,6 +185,7 @@ void SimRuntime::move_bytes_in(double wall, double now) {
         ++bytes_garbled_;
         log_.write_event("garble", now, {{"from", was}, {"to", byte}});
       }
+      if (options_.personality == "grbl") log_realtime_byte(byte, now);
       protocol_->on_byte(byte, now);
       if (byte == '\n') ++line_ends_in_;
       // Unplug right after the N-th line's end: the bytes after it never reach the controller.
@@ -196,6 +197,23 @@ void SimRuntime::move_bytes_in(double wall, double now) {
       }
     }
   }
+}
+
+// Hold, resume and reset as they reach the controller, stamped on CLOCK_MONOTONIC (steady_clock),
+// which every process on the machine shares: a host that notes when it asked can measure its
+// real-time path to the controller, queues and pacing included (bench/hold_latency). Status
+// polls (`?`) are not logged: they come five times a second.
+void SimRuntime::log_realtime_byte(std::uint8_t byte, double now) {
+  const char* name = nullptr;
+  switch (byte) {
+    case '!': case 0x82: name = "feed_hold"; break;
+    case '~': case 0x81: name = "cycle_start"; break;
+    case 0x18: name = "reset"; break;
+    default: return;
+  }
+  const double mono_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+  log_.write_event("realtime", now, {{"command", name}, {"mono_s", mono_s}});
 }
 
 void SimRuntime::move_bytes_out(double wall) {

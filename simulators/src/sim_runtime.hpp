@@ -40,6 +40,7 @@ class SimRuntime {
   void step();
   void move_bytes_in(double wall, double now);
   void move_bytes_out(double wall);
+  void log_realtime_byte(std::uint8_t byte, double now);
   void tick_plc(double now);
   void apply_schedule(double wall, double now);
   void unplug(double now, const std::string& why);

@@ -67,6 +67,9 @@ void expect_same(const DaemonConfig& a, const DaemonConfig& b) {
   EXPECT_EQ(a.link.status_hz, b.link.status_hz);
   EXPECT_EQ(a.cell.enabled, b.cell.enabled);
   EXPECT_EQ(a.cell.modbus, b.cell.modbus);
+  EXPECT_EQ(a.cell.modbus_unit, b.cell.modbus_unit);
+  EXPECT_EQ(a.cell.modbus_timeout_s, b.cell.modbus_timeout_s);
+  EXPECT_EQ(a.cell.modbus_reconnects, b.cell.modbus_reconnects);
   EXPECT_EQ(a.cell.heartbeat_period_s, b.cell.heartbeat_period_s);
   EXPECT_EQ(a.cell.pump_ready_timeout_s, b.cell.pump_ready_timeout_s);
   EXPECT_EQ(a.cell.pressure_setpoint_mpa, b.cell.pressure_setpoint_mpa);
@@ -251,6 +254,21 @@ TEST(DaemonConfig, TheCellNeedsItsPlcAddressWhenEnabled) {
   EXPECT_NE(error_of("[cell]\nmodbus = \"\"\n").find("test.toml:2: [cell] modbus:"), std::string::npos);
   EXPECT_NE(error_of("[cell]\nmodbus = \"plc\"\n").find("test.toml:2: [cell] modbus: expected \"HOST:PORT\""),
             std::string::npos);
+  EXPECT_NE(error_of("[cell]\nmodbus = \"plc:0\"\n").find("[cell] modbus: expected"), std::string::npos);
+  EXPECT_NE(error_of("[cell]\nmodbus = \"::1:502\"\n").find("[cell] modbus: expected"), std::string::npos)
+      << "an IPv6 host needs its brackets";
+  EXPECT_NE(error_of("[cell]\nmodbus_unit = 256\n").find("test.toml:2: [cell] modbus_unit: 256 is out of range"),
+            std::string::npos);
+  EXPECT_NE(error_of("[cell]\nmodbus_timeout_s = 0\n").find("[cell] modbus_timeout_s"), std::string::npos);
+  EXPECT_NE(error_of("[cell]\nmodbus_reconnects = -1\n").find("[cell] modbus_reconnects"), std::string::npos);
+  // A PLC behind a gateway: its address, unit id and patience.
+  auto gw = parse_daemon_config("[cell]\nmodbus = \"[fd00::7]:1502\"\nmodbus_unit = 17\nmodbus_timeout_s = 1.5\n"
+                                "modbus_reconnects = 0\n", "t.toml");
+  ASSERT_TRUE(gw.has_value()) << gw.error().message;
+  EXPECT_EQ(gw->cell.modbus, "[fd00::7]:1502");
+  EXPECT_EQ(gw->cell.modbus_unit, 17);
+  EXPECT_EQ(gw->cell.modbus_timeout_s, 1.5);
+  EXPECT_EQ(gw->cell.modbus_reconnects, 0);
   auto off = parse_daemon_config("[cell]\nenabled = false\nmodbus = \"\"\n", "t.toml");
   ASSERT_TRUE(off.has_value()) << off.error().message;
   EXPECT_FALSE(off->cell.enabled);

@@ -16,7 +16,7 @@ using namespace testing;
 
 CellIoSettings settings_for(int port) {
   CellIoSettings s;
-  s.port = port;
+  s.plc.port = port;
   s.poll_period_s = 0.05;
   s.heartbeat_period_s = 0.1;  // the sim's watchdog is 500 ms
   s.pump_ready_timeout_s = 3;
@@ -137,9 +137,31 @@ TEST(CellIo, PrepareWithTheDoorOpenIsRefusedNamingTheDoor) {
   EXPECT_EQ(plc.coil(map::kCoilJet), 0);
 }
 
+// A shop names its PLC ("plc-cell1"), or gives an IPv6 address: both must reach it.
+TEST(CellIo, APlcNamedByItsHostNameIsReached) {
+  SimCell cell;
+  auto settings = settings_for(cell.sim.modbus_port());
+  settings.plc.host = "localhost";  // may resolve to ::1 first: the sim listens on 127.0.0.1 only
+  CellIo io(settings);
+  auto r = io.prepare_cut();
+  ASSERT_TRUE(r) << r.error().message;
+  EXPECT_TRUE(io.status().connected);
+  io.jet_off();
+}
+
+TEST(CellIo, AHostNameThatDoesNotResolveIsNamedInTheError) {
+  auto settings = settings_for(502);
+  settings.plc.host = "no-such-plc.invalid";  // RFC 2606: never resolves
+  settings.plc.max_reconnects = 1;
+  CellIo io(settings);
+  auto r = io.prepare_cut();
+  ASSERT_FALSE(r);
+  EXPECT_NE(r.error().message.find("cannot resolve 'no-such-plc.invalid'"), std::string::npos) << r.error().message;
+}
+
 TEST(CellIo, UnreachablePlcGivesUpAfterBoundedReconnects) {
   auto settings = settings_for(unused_port());
-  settings.max_reconnects = 3;
+  settings.plc.max_reconnects = 3;
   CellIo io(settings);
   const auto t0 = std::chrono::steady_clock::now();
   auto r = io.prepare_cut();
@@ -161,8 +183,8 @@ TEST(CellIo, SilentPlcTimesOutAndGivesUpAfterBoundedReconnects) {
   socklen_t len = sizeof addr;
   ::getsockname(fd, reinterpret_cast<sockaddr*>(&addr), &len);
   auto settings = settings_for(ntohs(addr.sin_port));
-  settings.response_timeout_s = 0.2;
-  settings.max_reconnects = 2;
+  settings.plc.response_timeout_s = 0.2;
+  settings.plc.max_reconnects = 2;
   {
     CellIo io(settings);
     const auto t0 = std::chrono::steady_clock::now();

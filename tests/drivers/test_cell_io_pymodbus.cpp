@@ -91,7 +91,7 @@ TEST(CellIoPeer, PrepareCutAgainstPymodbusWritesTheCoils) {
   }, 15.0)) << "the pymodbus server did not come up";
 
   CellIoSettings settings;
-  settings.port = port;
+  settings.plc.port = port;
   settings.pump_ready_timeout_s = 2;
   auto io = std::make_unique<CellIo>(settings);
   auto r = io->prepare_cut();

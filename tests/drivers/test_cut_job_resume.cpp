@@ -143,11 +143,11 @@ void pressure_drop_then_resume(const std::string& protocol) {
         make_xonxoff_protocol(), settings);
   } else {
     ModbusBlockSettings settings;
-    settings.port = sim.modbus_port();
+    settings.plc.port = sim.modbus_port();
     link = std::make_unique<ModbusBlockLink>(settings);
   }
   CellIoSettings cell_settings;
-  cell_settings.port = sim.modbus_port();
+  cell_settings.plc.port = sim.modbus_port();
   CellIo cell(cell_settings);
   CutJobSettings job_settings;
   job_settings.wait_for_idle = protocol != "xonxoff";

@@ -16,7 +16,7 @@ using namespace testing;
 
 ModbusBlockSettings settings_for(int port) {
   ModbusBlockSettings s;
-  s.port = port;
+  s.plc.port = port;
   s.ack_timeout_s = 2;
   s.status_period_s = 0.05;
   return s;

@@ -31,6 +31,9 @@ struct MachineLinkConfig {
 struct CellConfig {
   bool enabled = true;                     // a PLC minds pump and interlocks
   std::string modbus = "127.0.0.1:502";    // HOST:PORT
+  int modbus_unit = 1;                     // Modbus unit (slave) id; a gateway routes by it
+  double modbus_timeout_s = 0.5;           // per request
+  int modbus_reconnects = 3;               // per failed request, then the PLC is lost (the cut stops)
   double heartbeat_period_s = 0.2;
   double pump_ready_timeout_s = 10;
   double pressure_setpoint_mpa = 380;

@@ -14,21 +14,18 @@
 
 #include "lamina/drivers/controller_status.hpp"
 #include "lamina/drivers/link_error.hpp"
+#include "lamina/drivers/modbus_endpoint.hpp"
 
 namespace lamina::drivers {
 
 struct CellIoSettings {
-  std::string host = "127.0.0.1";
-  int port = 502;
-  int unit_id = 1;
-  double response_timeout_s = 0.5;
+  ModbusEndpoint plc;
   double heartbeat_period_s = 0.2;       // the PLC's watchdog must be longer
   double poll_period_s = 0.05;           // interlocks and pressure read this often while cutting
   std::uint16_t pressure_setpoint_01mpa = 3800;
   std::uint16_t abrasive_g_per_min = 350;
   double pump_ready_timeout_s = 10;      // pump on → pump_ready
   double min_pressure_fraction = 0.9;    // below this × set point while cutting: pressure fault
-  int max_reconnects = 3;                // per fault, then the cell is declared lost
   double cnc_reset_timeout_s = 5;        // the PLC's reset (hold) button → the CNC reads idle (still)
 };
 

@@ -7,17 +7,14 @@
 #include <string>
 
 #include "lamina/drivers/machine_link.hpp"
+#include "lamina/drivers/modbus_endpoint.hpp"
 
 namespace lamina::drivers {
 
 struct ModbusBlockSettings {
-  std::string host = "127.0.0.1";
-  int port = 502;
-  int unit_id = 1;
-  double response_timeout_s = 0.5;
+  ModbusEndpoint plc;
   double ack_timeout_s = 5;        // a block not acknowledged within this: timeout, job stops
   double status_period_s = 0.2;
-  int max_reconnects = 3;
 };
 
 class ModbusBlockLink final : public MachineLink {
