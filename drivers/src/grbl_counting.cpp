@@ -59,7 +59,7 @@ class CountingProtocol final : public LineProtocol {
     halted_ = false;
   }
 
-  std::string take_sendable() override {
+  std::string take_sendable(std::size_t max_bytes) override {
     std::string out;
     if (halted_ || !handshake_done_) return out;
     const std::size_t window = window_bytes();
@@ -73,6 +73,7 @@ class CountingProtocol final : public LineProtocol {
         if (settings_.one_line_in_flight) break;
         if (in_flight_bytes_ + bytes > window) break;
       }
+      if (!out.empty() && out.size() + bytes > max_bytes) break;  // the pacer's budget (one line at least)
       // A line longer than the whole window goes alone: the controller refuses it (error:11,
       // line overflow) instead of the stream stalling forever.
       out.append(line);

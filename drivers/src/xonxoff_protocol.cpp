@@ -51,9 +51,9 @@ class XonXoffProtocol final : public LineProtocol {
     halted_ = false;
   }
 
-  std::string take_sendable() override {
-    if (halted_ || xoff_ || offset_ >= text_.size()) return {};
-    const std::size_t n = std::min(settings_.chunk_bytes, text_.size() - offset_);
+  std::string take_sendable(std::size_t max_bytes) override {
+    if (halted_ || xoff_ || offset_ >= text_.size() || max_bytes == 0) return {};
+    const std::size_t n = std::min({settings_.chunk_bytes, max_bytes, text_.size() - offset_});
     std::string out = text_.substr(offset_, n);
     offset_ += n;
     while (written_lines_ < line_ends_.size() && line_ends_[written_lines_] <= offset_) ++written_lines_;

@@ -20,6 +20,10 @@ class BytePacer {
     return static_cast<std::size_t>(credit_);
   }
   void consume(std::size_t bytes) { credit_ -= static_cast<double>(bytes); }
+  // Nothing was waiting to cross: the wire idled, and a byte written from now on takes its own
+  // time on the wire. Without this, bytes written after a pause crossed at once on the saved
+  // credit (up to the burst), and a real-time byte behind them looked faster than a UART.
+  void idle() { credit_ = std::min(credit_, 0.0); }
   // Seconds until one more byte may cross (for the loop's sleep).
   double seconds_to_next_byte() const { return credit_ >= 1 ? 0 : (1 - credit_) / bytes_per_s_; }
   double bytes_per_s() const { return bytes_per_s_; }

@@ -173,7 +173,10 @@ void SimRuntime::move_bytes_in(double wall, double now) {
   std::uniform_int_distribution<int> bit(0, 7);
   while (allowed > 0) {
     const long n = port_->read_some(buffer, std::min(allowed, sizeof buffer));
-    if (n <= 0) break;
+    if (n <= 0) {
+      rx_pacer_.idle();  // the client's queue is empty: the wire idles
+      break;
+    }
     rx_pacer_.consume(static_cast<std::size_t>(n));
     allowed -= static_cast<std::size_t>(n);
     for (long i = 0; i < n; ++i) {
@@ -222,6 +225,7 @@ void SimRuntime::move_bytes_out(double wall) {
     tx_pending_.clear();  // nobody on the line: what the controller says is lost
     return;
   }
+  if (tx_pending_.empty()) tx_pacer_.idle();  // nothing to say: the wire idles
   while (allowed > 0 && !tx_pending_.empty()) {
     const std::size_t n = std::min(allowed, tx_pending_.size());
     const long written = port_->write_some(reinterpret_cast<const std::uint8_t*>(tx_pending_.data()), n);

@@ -44,6 +44,26 @@ TEST(GrblProtocol, HandshakeLearnsBuildInfoAtItsOk) {
   EXPECT_EQ(count_lines(p->take_sendable()), 3u);
 }
 
+// The pacer's budget: whole lines up to it, at least one line however long; the window still
+// bounds the total. Without the budget a resume handed out a whole 1 KiB window at once, and a
+// feed hold queued behind it waited 88 ms for the wire (bench/hold_latency).
+TEST(GrblProtocol, TakeSendableKeepsToTheByteBudgetInWholeLines) {
+  auto p = connected_grbl(1024);
+  p->load(program(200, 10));  // 2000 bytes: more than the window
+  const std::string first = p->take_sendable(25);
+  EXPECT_LE(first.size(), 25u);
+  EXPECT_GE(count_lines(first), 1u);
+  EXPECT_EQ(first.back(), '\n') << "never half a line";
+  const std::string one = p->take_sendable(1);
+  EXPECT_EQ(count_lines(one), 1u) << "a line longer than the budget goes alone";
+  std::size_t total = first.size() + one.size();
+  for (std::string more; !(more = p->take_sendable(100)).empty();) {
+    EXPECT_LE(more.size(), 100u);
+    total += more.size();
+  }
+  EXPECT_LE(total, 1024u) << "the window still bounds what is in flight";
+}
+
 TEST(GrblProtocol, ResetDuringTheHandshakeNeedsItAgain) {
   // Opening a port resets many Grbl boards (DTR): the `$I` sent at once is lost in the boot.
   auto p = make_grbl_protocol();

@@ -29,6 +29,16 @@ TEST(XonXoffProtocol, FramesTheProgramUnlessItIsFramed) {
   EXPECT_EQ(unframed->take_sendable(), "G1X1\n");
 }
 
+TEST(XonXoffProtocol, TakeSendableKeepsToTheByteBudget) {
+  auto p = make_xonxoff_protocol({.chunk_bytes = 10});
+  p->load(LineSpan{{"O1000", "G1X1", "M30"}, 0});
+  EXPECT_EQ(p->take_sendable(0), "");
+  EXPECT_EQ(p->take_sendable(3), "%\nO") << "a byte stream: the budget may split a line";
+  EXPECT_EQ(p->take_sendable(100), "1000\nG1X1\n") << "the chunk bounds it";
+  EXPECT_EQ(p->take_sendable(100), "M30\n%\n");
+  EXPECT_EQ(p->take_sendable(100), "");
+}
+
 TEST(XonXoffProtocol, Dc3StopsAtOnceDc1ResumesAtTheNextByte) {
   constexpr std::size_t kChunk = 7;
   auto p = make_xonxoff_protocol({.chunk_bytes = kChunk});

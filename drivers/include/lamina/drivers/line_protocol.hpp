@@ -8,6 +8,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <limits>
 #include <string>
 #include <string_view>
 #include <variant>
@@ -67,8 +68,11 @@ class LineProtocol {
 
   // Load lines to stream. Replaces whatever was loaded; nothing may be in flight.
   virtual void load(LineSpan span) = 0;
-  // Bytes that may go on the wire now (window, XOFF, one-in-flight…), marked as sent.
-  virtual std::string take_sendable() = 0;
+  // Bytes that may go on the wire now (window, XOFF, one-in-flight…), marked as sent, at most
+  // `max_bytes` of them — but a whole line where the protocol sends whole lines, so a line
+  // longer than the budget goes alone (the pacer's budget is then overrun by one line).
+  virtual std::string take_sendable(std::size_t max_bytes) = 0;
+  std::string take_sendable() { return take_sendable(std::numeric_limits<std::size_t>::max()); }
   // Stop handing out program bytes (after an error or alarm, or on the operator's stop).
   virtual void halt() = 0;
   // Bytes that arrived; the events they complete, in order.
