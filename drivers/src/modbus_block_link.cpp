@@ -216,11 +216,16 @@ struct ModbusBlockLink::Impl {
         ++progress.lines_sent;
         progress.bytes_sent += line.size();
       }
-      // The acknowledge.
-      const auto deadline = Clock::now() + seconds(settings.ack_timeout_s);
+      // The acknowledge. A CNC that is running or held has not lost the block: it takes a jet
+      // M-code, a program end or a dwell only once its queue has drained (the planner sync),
+      // which may take minutes of cutting, and a hold keeps it for as long as the operator
+      // likes. The timeout counts only while it stands idle with the block untaken.
+      auto deadline = Clock::now() + seconds(settings.ack_timeout_s);
       while (true) {
         if (auto r = read_cnc(); !r) return finish(at_line(r.error(), index, line), span.first_index);
         if (cnc[pm::kInMailboxAck] == seq) break;
+        if (const int state = cnc[pm::kInCncState]; state >= 1 && state <= 3)
+          deadline = Clock::now() + seconds(settings.ack_timeout_s);
         if (auto e = cnc_trouble(index, line)) return finish(e, span.first_index);
         if (auto e = stopped()) return finish(e, span.first_index);
         if (Clock::now() >= deadline)

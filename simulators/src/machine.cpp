@@ -36,6 +36,12 @@ namespace {
 // grblHAL's G4 waits for the planner to drain instead; either way the host sees the dwell
 // line acknowledged only once everything before it has a block.
 bool is_timed(const detail::PlannedBlock& b) { return b.duration_s > 0; }
+// grblHAL synchronises with the planner (protocol_buffer_synchronize) before a spindle — here
+// the jet — change, a program end and a dwell: the line waits unanswered until every motion
+// before it is done, so the machine stands still when the jet turns on or off.
+bool syncs(const detail::PlannedBlock& b) {
+  return b.jet_on.has_value() || b.program_end || b.kind == MotionMode::dwell;
+}
 }  // namespace
 
 Machine::Planned Machine::plan_line(std::string_view line) const {
@@ -80,6 +86,8 @@ GrblStatus Machine::submit_line(std::string_view line, double now_s) {
   if (!program_running_) moved_in_program_ = false;
   program_running_ = true;  // from the first block after Idle until M2/M30 executes
   starved_ = false;
+  draining_for_sync_ = false;
+  pending_stop_.reset();  // a block at the instant the queue ran dry: no stop after all
   queue_.push_back(std::move(planned));
   advance(now_s);
   return GrblStatus::ok;
@@ -87,11 +95,15 @@ GrblStatus Machine::submit_line(std::string_view line, double now_s) {
 
 bool Machine::has_room() const { return free_blocks() > 0; }
 bool Machine::has_room_for(std::string_view line) const {
-  if (alarm_ || has_room()) return true;
+  if (alarm_) return true;
   const Planned p = plan_line(line);
   if (p.status != GrblStatus::ok || !p.block) return true;  // answered without a block
   if (config_.soft_limits && !detail::within_soft_limits(*p.block, config_)) return true;
-  return !is_timed(*p.block);
+  if (syncs(*p.block) && queued_blocks() > 0) {
+    draining_for_sync_ = true;  // the queue runs dry on purpose: no starvation
+    return false;
+  }
+  return has_room() || !is_timed(*p.block);
 }
 std::size_t Machine::free_blocks() const {
   const std::size_t used = queued_timed_blocks();
@@ -131,6 +143,11 @@ double Machine::phase_end_s(const Running& r) const {
 }
 
 void Machine::advance(double now_s) {
+  run_queue(now_s);
+  confirm_pending_stop(now_s);
+}
+
+void Machine::run_queue(double now_s) {
   while (!alarm_) {
     if (!running_) {
       if (held_ || queue_.empty()) return;
@@ -177,20 +194,38 @@ void Machine::start_next(double t_s) {
 void Machine::finish_running(double t_s) {
   const detail::PlannedBlock& b = running_->block;
   const std::uint64_t seq = b.seq;
-  const double b_duration_s = b.duration_s;
+  const bool timed = is_timed(b), sync = syncs(b);
+  const double started_s = running_->t_start_s;
   events_.push_back(ExecutedBlock{b.seq, b.line, b.start, b.target, jet_, running_->t_start_s, t_s, true});
   pos_ = b.target;
   last_end_s_ = t_s;
   ++executed_;
   running_.reset();
-  if (b_duration_s > 0) moved_in_program_ = true;
-  // Starvation = the machine had to stop because no block was ready. Before the program's first
-  // timed block nothing was moving (the set-up lines run in no time), so that gap is not one.
-  if (queue_.empty() && program_running_ && moved_in_program_ && !held_ && !alarm_ && !starved_) {
-    events_.push_back(StarvationEvent{t_s, seq});
+  if (timed) {
+    moved_in_program_ = true;
+    last_motion_end_s_ = t_s;
+  }
+  // Starvation = the program stopped because no block was ready. The machine was going until
+  // now if this block moved or dwelt, was a jet change (after it the program goes on), or was
+  // a zero-time line queued behind a move that ended at this instant. A stop the program asks
+  // for — waiting for this drain (the planner sync) — is not one. Whether the queue really ran
+  // dry is decided when the next block comes: a line submitted at this very instant (the one
+  // behind a sync, taken in the same pass) means it did not.
+  const bool going = timed || sync || started_s <= last_motion_end_s_;
+  if (queue_.empty() && going && program_running_ && moved_in_program_ && !held_ && !alarm_ && !starved_ &&
+      !draining_for_sync_)
+    pending_stop_ = StarvationEvent{t_s, seq};
+}
+
+// A stop noted by finish_running becomes starvation once time has passed with nothing queued.
+void Machine::confirm_pending_stop(double now_s) {
+  if (!pending_stop_ || now_s <= pending_stop_->t_s) return;
+  if (queue_.empty() && !running_ && !held_ && !alarm_ && program_running_ && !starved_) {
+    events_.push_back(*pending_stop_);
     starved_ = true;
     ++starvations_;
   }
+  pending_stop_.reset();
 }
 
 void Machine::stop_running(double t_s) {
@@ -209,6 +244,8 @@ void Machine::reset_modal() {
   program_running_ = false;
   moved_in_program_ = false;
   starved_ = false;
+  draining_for_sync_ = false;
+  pending_stop_.reset();
 }
 
 void Machine::alarm_stop(GrblAlarm code, double t_s, std::uint64_t seq) {

@@ -96,9 +96,10 @@ class Machine {
   GrblStatus submit_line(std::string_view line, double now_s);
   // Capacity is planner_blocks timed blocks (motion with a non-zero length and dwell with a
   // non-zero time); the running one keeps its slot until it finishes (Grbl).
-  // has_room(): a timed block would fit. has_room_for(line): submit_line would not refuse
-  // this line with overflow (a zero-time line, a line with an error, a soft-limit target — the
-  // last two are answered at once, as grblHAL checks them before waiting for a block).
+  // has_room(): a timed block would fit. has_room_for(line): the line may be taken now — a
+  // timed block needs a free slot (a zero-time line does not); a jet M-code, M2/M30 and a dwell
+  // wait until the queue is empty (grblHAL's planner sync); a line with an error or a
+  // soft-limit target is answered at once, as grblHAL checks them before waiting.
   bool has_room() const;
   bool has_room_for(std::string_view line) const;
   std::size_t free_blocks() const;          // planner_blocks − queued_timed_blocks(): Grbl's Bf
@@ -153,6 +154,8 @@ class Machine {
   double phase_end_s(const Running& r) const;
   void start_next(double t_s);
   void finish_running(double t_s);
+  void run_queue(double now_s);  // advance()'s work: blocks start and finish up to now_s
+  void confirm_pending_stop(double now_s);
   void stop_running(double t_s);  // cut the running block short (reset, alarm)
   void alarm_stop(GrblAlarm code, double t_s, std::uint64_t seq);
   void reset_modal();
@@ -179,6 +182,11 @@ class Machine {
   bool program_running_ = false;
   bool moved_in_program_ = false;  // a timed block (motion, dwell) ran in this program
   bool starved_ = false;      // starvation already reported for this empty period
+  // A jet change, program end or dwell waits for the queue to drain (has_room_for said no):
+  // that empty queue is the program's own stop, not starvation.
+  mutable bool draining_for_sync_ = false;
+  std::optional<StarvationEvent> pending_stop_;  // the queue ran dry here; starvation unless a block comes at once
+  double last_motion_end_s_ = -1;                // when the last timed block ended
   std::uint64_t accepted_ = 0, executed_ = 0, starvations_ = 0;
   std::vector<MachineEvent> events_;
 };

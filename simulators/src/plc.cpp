@@ -71,6 +71,12 @@ void Plc::refuse_block(std::uint16_t seq) {
   publish(last_s_);
 }
 
+bool Plc::discard_pending_block() {
+  if (!pending_) return false;
+  pending_.reset();
+  return true;
+}
+
 CncButtons Plc::take_cnc_buttons() { return std::exchange(buttons_, CncButtons{}); }
 
 void Plc::take_cnc_buttons_from_coils() {

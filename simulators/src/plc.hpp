@@ -66,6 +66,10 @@ class Plc {
   std::optional<MailboxBlock> pending_block() const;
   void accept_block(std::uint16_t seq);
   void refuse_block(std::uint16_t seq);  // the CNC refused the text: latch kAlarmMailboxBadBlock
+  // The CNC was reset or went into alarm: a block not yet taken is dropped, never acknowledged
+  // and never executed (a jet-on block waiting for the planner to drain must not run after
+  // the reset that stopped the program). True when one was dropped.
+  bool discard_pending_block();
   // Buttons pressed since the last call (the CNC side acts on them once), then forgotten.
   CncButtons take_cnc_buttons();
 

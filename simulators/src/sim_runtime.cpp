@@ -134,8 +134,7 @@ void SimRuntime::step() {
       switch (options_.on_open) {
         case OnOpen::banner: protocol_->on_connect(now); break;
         case OnOpen::reset:  // the reset prints the banner itself (after ALARM:3 if it was moving)
-          protocol_->external_reset(now);
-          log_.write_event("reset", now, {{"source", "open"}});
+          reset_cnc(now, "open");
           break;
         case OnOpen::quiet: break;
       }
@@ -236,13 +235,26 @@ void SimRuntime::move_bytes_out(double wall) {
   }
 }
 
+// The CNC's reset, whoever pressed it: the controller stops and flushes (protocol), and a
+// block still waiting in the PLC's mailbox goes with the rest of the program.
+void SimRuntime::reset_cnc(double now, const char* source) {
+  std::lock_guard lock(plc_mutex_);
+  reset_cnc_locked(now);
+  log_.write_event("reset", now, {{"source", source}});
+}
+
+void SimRuntime::reset_cnc_locked(double now) {
+  protocol_->external_reset(now);
+  if (plc_.discard_pending_block()) log_.write_event("mailbox_discarded", now, {{"why", "reset"}});
+}
+
 void SimRuntime::tick_plc(double now) {
   std::lock_guard lock(plc_mutex_);
   // The CNC's panel buttons wired through the PLC (coils 4…6): the same actions as the serial
   // line's real-time bytes, so a Modbus-fed controller can be held, resumed and reset. Taken
   // before the snapshot, so the state the PLC publishes already shows what a press did.
   if (const CncButtons pressed = plc_.take_cnc_buttons(); pressed.any()) {
-    if (pressed.reset) protocol_->external_reset(now);
+    if (pressed.reset) reset_cnc_locked(now);
     if (pressed.feed_hold) machine_.feed_hold(now);
     if (pressed.cycle_start) machine_.cycle_start(now);
     log_.write_event("plc_button", now, {{"feed_hold", pressed.feed_hold}, {"cycle_start", pressed.cycle_start},
@@ -262,6 +274,8 @@ void SimRuntime::tick_plc(double now) {
     machine_.set_estop(estop_applied_, now);
     log_.write_event(estop_applied_ ? "estop" : "estop_released", now);
   }
+  // A block waiting in the mailbox dies with the program an alarm stopped.
+  if (machine_.alarm() && plc_.discard_pending_block()) log_.write_event("mailbox_discarded", now, {{"why", "alarm"}});
   // Blocks written into the Modbus mailbox go into the same queue as the serial line's (a
   // motion block waits for a free planner block, other blocks pass at once).
   if (const auto block = plc_.pending_block(); block && machine_.has_room_for(block->text)) {
@@ -383,8 +397,7 @@ std::string SimRuntime::handle_command(const std::string& line) {
       return "ok";
     }
     if (verb == "reset") {  // the operator's reset button on the controller's panel
-      protocol_->external_reset(now);
-      log_.write_event("reset", now, {{"source", "control"}});
+      reset_cnc(now, "control");
       return "ok";
     }
     if (verb == "garble") {

@@ -42,6 +42,8 @@ class SimRuntime {
   void move_bytes_out(double wall);
   void log_realtime_byte(std::uint8_t byte, double now);
   void tick_plc(double now);
+  void reset_cnc(double now, const char* source);  // takes the PLC lock
+  void reset_cnc_locked(double now);               // the caller holds it
   void apply_schedule(double wall, double now);
   void unplug(double now, const std::string& why);
   std::string handle_command(const std::string& line);

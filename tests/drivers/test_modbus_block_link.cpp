@@ -59,6 +59,23 @@ TEST(ModbusBlockLink, ASecondJobContinuesTheSequenceNumbers) {
   ASSERT_TRUE(wait_status(cell.sim.control_port(), [](const nlohmann::json& st) { return st["executed_blocks"] == 20; }, 10));
 }
 
+// The CNC takes a jet M-code only once its queue has drained (planner sync): a mailbox block
+// may wait for seconds of cutting. That is a busy CNC, not a lost block: no timeout.
+TEST(ModbusBlockLink, AJetChangeWaitingForTheQueueToDrainIsNoTimeout) {
+  SimCell cell({"--time-scale", "1"});
+  auto settings = settings_for(cell.sim.modbus_port());
+  settings.ack_timeout_s = 0.5;
+  ModbusBlockLink link(settings);
+  auto program = program_of(20, 600);  // 18 moves of 1-6 mm at 10 mm/s: ~3 s queued ahead of M5
+  program.insert(program.end(), {"M5", "G0X0Y0"});
+  link.start(LineSpan{program, 0}, {});
+  const auto outcome = link.wait(30);
+  ASSERT_TRUE(outcome);
+  ASSERT_TRUE(outcome->completed) << (outcome->error ? outcome->error->message : "");
+  ASSERT_TRUE(wait_status(cell.sim.control_port(),
+                          [&](const nlohmann::json& st) { return st["executed_blocks"] == program.size(); }, 20));
+}
+
 TEST(ModbusBlockLink, FeedHoldAndResumeGoThroughThePlcCoils) {
   SimCell cell({"--planner-blocks", "5"});  // the queue fills: the job is still streaming when stopped
   ModbusBlockLink link(settings_for(cell.sim.modbus_port()));

@@ -256,6 +256,30 @@ TEST(GrblProtocol, FullPlannerBackPressuresTheReceiveBuffer) {
   EXPECT_EQ(g.protocol->rx_free(), 1024u);
 }
 
+// grblHAL's planner sync: M3 (jet on) is answered only when the motion before it is done, and
+// the lines behind it wait with it; the jet turns on with the machine standing still.
+TEST(GrblProtocol, AJetMCodeWaitsForTheMotionBeforeIt) {
+  Grbl g(MachineConfig{});
+  g.send("G1X10F600\nM3\nG1X20\nM5\nM30\n");  // each move takes 1 s
+  EXPECT_EQ(count_of(g.take(), "ok"), 1) << "M3 and the lines behind it wait in the receive buffer";
+  g.run_for(0.9);
+  EXPECT_EQ(count_of(g.take(), "ok"), 0);
+  g.run_for(0.2);
+  EXPECT_EQ(count_of(g.take(), "ok"), 2) << "M3 and the move behind it, once the first move is done";
+  g.run_for(2.0);
+  EXPECT_EQ(count_of(g.take(), "ok"), 2) << "M5 and M30 after the second move";
+  const auto events = g.machine.take_events();
+  std::vector<ExecutedBlock> done;
+  for (const auto& e : events)
+    if (const auto* b = std::get_if<ExecutedBlock>(&e)) done.push_back(*b);
+  ASSERT_EQ(done.size(), 5u);
+  EXPECT_GE(done[1].t_start_s, done[0].t_end_s - 1e-9) << "the jet turns on after the move";
+  EXPECT_GE(done[3].t_start_s, done[2].t_end_s - 1e-9) << "and off after the next";
+  EXPECT_FALSE(done[0].jet);
+  EXPECT_TRUE(done[2].jet);
+  EXPECT_EQ(g.machine.starvation_count(), 0u) << "a sync is the program's own stop";
+}
+
 TEST(GrblProtocol, DropOkFaultLosesExactlyTheKthOk) {
   GrblParams params;
   params.faults.drop_ok_index = 2;

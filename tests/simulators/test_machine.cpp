@@ -149,9 +149,9 @@ TEST(Machine, QueueCapacityCountsOnlyTimedBlocks) {
   EXPECT_FALSE(m.has_room_for("X30"));  // modal G1: a move too
   EXPECT_EQ(m.submit_line("G1X30", 0), GrblStatus::overflow);
   EXPECT_EQ(m.accepted_blocks(), 4u);
-  EXPECT_TRUE(m.has_room_for("M3"));
+  EXPECT_FALSE(m.has_room_for("M3"));      // a jet change waits for the queue to drain (planner sync)
   EXPECT_TRUE(m.has_room_for("G1X20"));    // already there: an empty move, no block (grblHAL)
-  EXPECT_TRUE(m.has_room_for("G4P0"));     // no time, no block
+  EXPECT_FALSE(m.has_room_for("G4P0"));    // a dwell syncs too, even with no time
   EXPECT_FALSE(m.has_room_for("G4P0.5"));  // a dwell takes one (our simplification)
   EXPECT_TRUE(m.has_room_for("G1X1B5"));   // an error is answered at once, no block needed
   ok(m, "M3", 0);
@@ -345,6 +345,31 @@ TEST(Machine, SetUpLinesArrivingSlowlyAreNoStarvation) {
                                [](const MachineEvent& e) { return std::holds_alternative<StarvationEvent>(e); });
   ASSERT_NE(it, events.end());
   EXPECT_NEAR(std::get<StarvationEvent>(*it).t_s, 2, 1e-9);
+}
+
+TEST(Machine, JetChangesProgramEndAndDwellWaitForTheQueueToDrain) {
+  Machine m({});
+  ok(m, "G1X10F600", 0);  // 0-1 s
+  EXPECT_FALSE(m.has_room_for("M3")) << "the jet waits for the motion before it";
+  EXPECT_FALSE(m.has_room_for("M5"));
+  EXPECT_FALSE(m.has_room_for("M30"));
+  EXPECT_FALSE(m.has_room_for("G4P0.5"));
+  EXPECT_TRUE(m.has_room_for("G1X20")) << "motion is planned ahead";
+  EXPECT_TRUE(m.has_room_for("(CONTOUR 2)"));
+  EXPECT_TRUE(m.has_room_for("G94"));
+  m.advance(1.0);
+  EXPECT_TRUE(m.has_room_for("M3"));
+  ok(m, "M3", 1.0);
+  ok(m, "G1X20", 1.0);  // 1-2 s
+  ok(m, "M30", 1.0);    // queued behind it (submit_line itself does not sync): the program ends at 2 s
+  m.advance(5);
+  EXPECT_EQ(m.starvation_count(), 0u) << "the drain before M3 was asked for: no starvation";
+  // A slow sender is still starvation: the queue ran dry with no sync waiting.
+  ok(m, "G1X30", 5);  // 5-6 s
+  ok(m, "G1X40", 7);  // 7-8 s: the queue was dry from 6 s
+  ok(m, "M30", 7);
+  m.advance(10);
+  EXPECT_EQ(m.starvation_count(), 1u);
 }
 
 TEST(Machine, ProgramEndStopsTheJetAndEndsTheProgram) {

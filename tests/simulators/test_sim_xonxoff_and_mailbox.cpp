@@ -2,6 +2,8 @@
 // block mailbox — each executes the program line for line.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <modbus/modbus.h>
 
 #include "grbl_client.hpp"
@@ -92,6 +94,26 @@ TEST(SimXonXoff, ResetSendsDc3ThenSyn) {
   EXPECT_EQ(c.buffer().find(kDc3), c.buffer().find('\x16') - 1) << "DC3 immediately before SYN";
 }
 
+// One FC16 write into the PLC's mailbox: sequence number, length, text two characters a register.
+bool write_mailbox(modbus_t* ctx, uint16_t seq, const std::string& block) {
+  uint16_t regs[2 + 100] = {};
+  regs[0] = seq;
+  regs[1] = static_cast<uint16_t>(block.size());
+  for (std::size_t i = 0; i < block.size(); ++i)
+    regs[2 + i / 2] |= static_cast<uint16_t>(static_cast<uint8_t>(block[i]) << (i % 2 == 0 ? 8 : 0));
+  const int count = static_cast<int>(2 + (block.size() + 1) / 2);
+  return modbus_write_registers(ctx, 10, count, regs) == count;
+}
+
+// mailbox_ack once it equals `seq`, or whatever it is after `wait_s`.
+uint16_t wait_ack(modbus_t* ctx, uint16_t seq, double wait_s) {
+  uint16_t ack = 0;
+  const auto t0 = std::chrono::steady_clock::now();
+  do modbus_read_input_registers(ctx, 4, 1, &ack);
+  while (ack != seq && seconds_since(t0) < wait_s);
+  return ack;
+}
+
 TEST(SimMailbox, BlocksWrittenOverModbusExecuteInOrder) {
   TempDir dir;
   SimProcess sim({"--link", dir.file("cnc"), "--modbus", "127.0.0.1:0", "--log", dir.file("exec.jsonl"),
@@ -102,21 +124,12 @@ TEST(SimMailbox, BlocksWrittenOverModbusExecuteInOrder) {
   uint16_t seq = 0;
   for (const auto& block : program) {
     ++seq;
-    uint16_t regs[2 + 100] = {};
-    regs[0] = seq;
-    regs[1] = static_cast<uint16_t>(block.size());
-    for (std::size_t i = 0; i < block.size(); ++i)
-      regs[2 + i / 2] |= static_cast<uint16_t>(static_cast<uint8_t>(block[i]) << (i % 2 == 0 ? 8 : 0));
     // Wait for room, then one FC16 write: seq, length, text.
     uint16_t free_blocks = 0;
     for (int i = 0; i < 200 && free_blocks == 0; ++i) modbus_read_input_registers(ctx, 5, 1, &free_blocks);
     ASSERT_GT(free_blocks, 0);
-    ASSERT_EQ(modbus_write_registers(ctx, 10, static_cast<int>(2 + (block.size() + 1) / 2), regs),
-              static_cast<int>(2 + (block.size() + 1) / 2));
-    uint16_t ack = 0;
-    const auto t0 = std::chrono::steady_clock::now();
-    while (ack != seq && seconds_since(t0) < 2) modbus_read_input_registers(ctx, 4, 1, &ack);
-    ASSERT_EQ(ack, seq) << "block " << block;
+    ASSERT_TRUE(write_mailbox(ctx, seq, block));
+    ASSERT_EQ(wait_ack(ctx, seq, 2), seq) << "block " << block;
   }
   modbus_close(ctx);
   modbus_free(ctx);
@@ -127,6 +140,32 @@ TEST(SimMailbox, BlocksWrittenOverModbusExecuteInOrder) {
   ASSERT_EQ(blocks.size(), program.size());
   for (std::size_t i = 0; i < blocks.size(); ++i) EXPECT_EQ(blocks[i]["line"], program[i]);
   EXPECT_NEAR(blocks.back()["end"][4].get<double>(), 45, 1e-9);
+}
+
+// A jet-on block waits in the mailbox for the motion before it (the planner sync). A reset in
+// the meantime stops the program: the block must die with it, not turn the jet on afterwards.
+TEST(SimMailbox, AJetOnBlockWaitingForTheDrainDiesWithAReset) {
+  TempDir dir;
+  SimProcess sim({"--link", dir.file("cnc"), "--modbus", "127.0.0.1:0", "--log", dir.file("exec.jsonl"),
+                  "--control", "127.0.0.1:0"});
+  modbus_t* ctx = modbus_new_tcp("127.0.0.1", sim.modbus_port());
+  ASSERT_EQ(modbus_connect(ctx), 0);
+  ASSERT_TRUE(write_mailbox(ctx, 1, "G1X50F600"));  // 5 s of motion
+  ASSERT_EQ(wait_ack(ctx, 1, 2), 1);
+  ASSERT_TRUE(write_mailbox(ctx, 2, "M3"));
+  EXPECT_EQ(wait_ack(ctx, 2, 0.3), 1) << "M3 waits for the move to finish";
+  EXPECT_EQ(control(sim.control_port(), "reset"), "ok");
+  EXPECT_EQ(wait_ack(ctx, 2, 0.5), 1) << "never taken";
+  const auto st = control_status(sim.control_port());
+  EXPECT_EQ(st["queued_blocks"], 0);
+  EXPECT_EQ(st["accepted_blocks"], 1) << "the M3 never reached the CNC";
+  modbus_close(ctx);
+  modbus_free(ctx);
+  const auto log = read_log(dir.file("exec.jsonl"));
+  EXPECT_TRUE(std::any_of(log.begin(), log.end(), [](const nlohmann::json& r) {
+    return r.value("event", "") == "mailbox_discarded" && r.value("why", "") == "reset";
+  }));
+  for (const auto& b : executed_blocks(log)) EXPECT_FALSE(b["jet"].get<bool>()) << b.dump();
 }
 
 }  // namespace

@@ -13,7 +13,7 @@ namespace lamina::drivers {
 
 struct ModbusBlockSettings {
   ModbusEndpoint plc;
-  double ack_timeout_s = 5;        // a block not acknowledged within this: timeout, job stops
+  double ack_timeout_s = 5;        // a block the CNC leaves untaken this long while idle: timeout, job stops
   double status_period_s = 0.2;
 };
 
