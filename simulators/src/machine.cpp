@@ -32,9 +32,8 @@ Machine::Machine(MachineConfig config) : config_(std::move(config)) {}
 
 namespace {
 // Occupies a planner slot: grblHAL plans a block only for a move that goes somewhere (an empty
-// move is dropped by plan_buffer_line). Simplification: a dwell takes a slot too, although
-// grblHAL's G4 waits for the planner to drain instead; either way the host sees the dwell
-// line acknowledged only once everything before it has a block.
+// move is dropped by plan_buffer_line). Simplification: a dwell takes a slot too (after the
+// drain syncs() asks for), where grblHAL dwells outside the planner; the timeline is the same.
 bool is_timed(const detail::PlannedBlock& b) { return b.duration_s > 0; }
 // grblHAL synchronises with the planner (protocol_buffer_synchronize) before a spindle — here
 // the jet — change, a program end and a dwell: the line waits unanswered until every motion
