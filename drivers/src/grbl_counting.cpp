@@ -2,6 +2,7 @@
 // every line sent is remembered with its length; each `ok` or `error:N` answers the oldest
 // one, and a line goes out only while the remembered lengths plus its own fit in the
 // controller's receive buffer. With a window of one line it is plain send-response.
+#include <algorithm>
 #include <deque>
 #include <utility>
 
@@ -112,12 +113,17 @@ class CountingProtocol final : public LineProtocol {
   bool finished() const override { return accepted_ == span_.lines.size(); }
 
  private:
-  std::size_t window_bytes() const {
+  // The receive buffer as the controller names it (configured, else `[OPT:]`, else 128).
+  std::size_t buffer_bytes() const {
     if (settings_.rx_buffer_bytes != 0) return settings_.rx_buffer_bytes;
     if (learned_.rx_buffer_bytes && *learned_.rx_buffer_bytes > 0)
       return static_cast<std::size_t>(*learned_.rx_buffer_bytes);
     return kClassicGrblRxBytes;
   }
+  // What it holds: a ring buffer of N bytes keeps one slot empty to tell full from empty
+  // (grblHAL's stream drivers and Grbl's serial.c alike; grblHAL's Bf shows at most N − 1
+  // free). Filling all N loses the last byte — a line's '\n', merging two lines.
+  std::size_t window_bytes() const { return std::max<std::size_t>(1, buffer_bytes() - 1); }
 
   void on_line(const std::string& line, std::vector<ProtocolEvent>& events) {
     const Reply reply = classify_reply(line);
@@ -161,7 +167,7 @@ class CountingProtocol final : public LineProtocol {
         // A controller without `$I` answers error:3 or similar: keep the defaults.
         handshake_done_ = true;
         ControllerInfo info = learned_;
-        info.rx_buffer_bytes = static_cast<int>(window_bytes());  // the window in use
+        info.rx_buffer_bytes = static_cast<int>(buffer_bytes());  // the size in use (the window is one less)
         events.emplace_back(std::move(info));
         return;
       }

@@ -111,8 +111,9 @@ struct XonXoffProtocolSettings {
 };
 
 // Grbl character counting. handshake() sends `$I`; its `ok` ends the handshake with a
-// ControllerInfo whose rx_buffer_bytes is the window in use (configured, else `[OPT:]`, else
-// 128). A banner (ControllerReset) during the handshake loses the `$I`: call handshake() again.
+// ControllerInfo whose rx_buffer_bytes is the receive buffer in use (configured, else
+// `[OPT:]`, else 128); unanswered lines are kept within one byte less, what a ring buffer of
+// that size holds. A banner (ControllerReset) during the handshake loses the `$I`: call handshake() again.
 // After LineRejected the caller sends clear_error_lock() (the protocol expects its `ok`); the
 // lines already in flight are answered by the error lock (or, after ALARM, refused or
 // flushed) and reported as nothing. A banner halts and forgets the lines in flight.
