@@ -11,6 +11,10 @@
 // - G4 in a block with axis words is modal_group_violation: one motion per block here.
 // - P without G4 is unused_words; arc words are checked by the executor (it knows the modal
 //   motion). T and S are accepted and ignored (a waterjet has no tool changer or spindle speed).
+// - B, D, E, H, L, Q, U, V, W are read as value words, as grblHAL's gc_execute_block keeps a
+//   letter without an axis as a macro parameter; nothing here uses them, so the executor
+//   answers unused_words (grblHAL's final "[Unused words]" check) once its other checks pass.
+// - G4, G28 and G53 share grblHAL's non-modal group 0 (one per block).
 // - Axis and arc words are kept as written: G20/G21 may come from an earlier line, so only the
 //   executor can convert them to mm.
 #include "gcode_block.hpp"
@@ -81,7 +85,8 @@ struct Seen {
   std::string letters;
   bool motion_group = false, units_group = false, distance_group = false, feed_mode_group = false;
   bool plane_group = false, comp_group = false, length_group = false, offset_group = false;
-  bool jet_group = false, stop_group = false;
+  bool jet_group = false, stop_group = false, spindle_group = false, coolant_group = false;
+  bool non_modal_group = false;  // G4 G28 G53
 };
 
 // Claim a modal group: false when the block already used it.
@@ -92,7 +97,15 @@ bool claim(bool& group) {
 }
 
 GrblStatus apply_g(int code, Block& b, Seen& seen) {
+  if ((code == 4 || code == 28 || code == 53) && !claim(seen.non_modal_group))
+    return GrblStatus::modal_group_violation;
   switch (code) {
+    case 28:
+      b.go_home = true;
+      return GrblStatus::ok;
+    case 53:
+      b.machine_coords = true;
+      return GrblStatus::ok;
     case 0: case 1: case 2: case 3: case 4: case 80: {
       // G80 (motion cancel) shares group 1 with G0-G3; G4 is non-modal but a block carries one
       // motion here, so it takes the same slot.
@@ -122,6 +135,9 @@ GrblStatus apply_g(int code, Block& b, Seen& seen) {
   }
 }
 
+// M3/M4/M5 are grblHAL's spindle group, M7/M8/M9 its coolant group; the jet follows the
+// configured jet codes (by default the spindle's M3/M4 on, M5 off). A configured jet code that
+// is no spindle code (a Fanuc's M62/M63, say) only switches the jet.
 GrblStatus apply_m(int code, Block& b, Seen& seen, const ParseParams& params) {
   if (code == 2 || code == 30) {
     if (!claim(seen.stop_group)) return GrblStatus::modal_group_violation;
@@ -129,9 +145,20 @@ GrblStatus apply_m(int code, Block& b, Seen& seen, const ParseParams& params) {
     return GrblStatus::ok;
   }
   const bool on = contains(params.jet_on_mcodes, code), off = contains(params.jet_off_mcodes, code);
+  if (on || off) b.jet_on = on;
+  switch (code) {
+    case 3: case 4: case 5:
+      if (!claim(seen.spindle_group)) return GrblStatus::modal_group_violation;
+      b.spindle = code == 3 ? SpindleCommand::cw : code == 4 ? SpindleCommand::ccw : SpindleCommand::off;
+      return GrblStatus::ok;
+    case 7: case 8: case 9:
+      if (!claim(seen.coolant_group)) return GrblStatus::modal_group_violation;
+      b.coolant = code == 7 ? CoolantCommand::mist : code == 8 ? CoolantCommand::flood : CoolantCommand::off;
+      return GrblStatus::ok;
+    default: break;
+  }
   if (!on && !off) return GrblStatus::unsupported_command;
   if (!claim(seen.jet_group)) return GrblStatus::modal_group_violation;
-  b.jet_on = on;
   return GrblStatus::ok;
 }
 
@@ -171,7 +198,7 @@ ParseResult parse_block(std::string_view line, const ParseParams& params) {
     i = j;
 
     // Unknown letters are refused before their number is looked at: the letter is the problem.
-    static constexpr std::string_view kKnown = "GMNFPXYZACIJKRTS";
+    static constexpr std::string_view kKnown = "GMNFPXYZACIJKRTSBDEHLQUVW";
     const bool program_number = letter == 'O' && params.accept_program_number;
     if (kKnown.find(letter) == std::string_view::npos && !program_number)
       return fail(GrblStatus::unsupported_command);
@@ -206,6 +233,9 @@ ParseResult parse_block(std::string_view line, const ParseParams& params) {
       case 'K': b.k_mm = value; break;
       case 'R': b.r_mm = value; break;
       case 'T': case 'S': break;  // accepted, no meaning on a waterjet
+      case 'B': case 'D': case 'E': case 'H': case 'L': case 'Q': case 'U': case 'V': case 'W':
+        b.unused_word = true;
+        break;
       case 'O':
         if (!is_integer(value) || value < 0) return fail(GrblStatus::command_value_not_integer);
         break;
@@ -215,6 +245,8 @@ ParseResult parse_block(std::string_view line, const ParseParams& params) {
     }
   }
 
+  // grblHAL: G28 sets the axis command itself, a motion command beside it is a conflict.
+  if (b.go_home && seen.motion_group) return fail(GrblStatus::axis_command_conflict);
   if (b.motion == MotionMode::dwell) {
     if (!b.dwell_s) return fail(GrblStatus::value_word_missing);
     if (any_axis) return fail(GrblStatus::modal_group_violation);

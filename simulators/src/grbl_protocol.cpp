@@ -30,8 +30,11 @@ class GrblProtocol final : public CncProtocol {
   GrblProtocol(Machine& machine, GrblParams params)
       : machine_(machine), params_(params), planner_blocks_(machine.planner_blocks()) {}
 
+  // report_init_message: the banner, at power-up and after every reset (whether a host opening
+  // the port brings one is the runtime's --on-open); it restarts the status report counters.
   void on_connect(double /*now_s*/) override {
     out_ += grbl::banner();
+    reporter_.restart();
     if (machine_.alarm()) out_ += fmt::format("[MSG:'$H'|'$X' to unlock]{}", grbl::kEol);
   }
 
@@ -45,20 +48,23 @@ class GrblProtocol final : public CncProtocol {
       case kStatusReport:
       case kStatusReportAll:
         machine_.advance(now_s);  // report the state as of this instant
-        out_ += grbl::status_report(machine_, rx_free(), now_s);
+        out_ += reporter_.report(machine_, rx_free(), now_s);
         return;
       case '!':
       case kFeedHold: machine_.feed_hold(now_s); return;
       case '~':
       case kCycleStart: machine_.cycle_start(now_s); return;
       case '\n':
-      case '\r': break;
+      case '\r':
+        // A line behind a running dwell: the controller takes it the moment the dwell ends.
+        if (awaiting_dwell_) machine_.expect_line_after_dwell();
+        break;
       default:
         // grblHAL drops other control characters, DEL and every top-bit byte it has no
         // handler for (0x84 safety door included: the simulator has no door state).
         if (byte < 0x20 || byte >= 0x7F) return;
     }
-    if (rx_.size() >= params_.rx_buffer_bytes) {
+    if (rx_.size() >= rx_capacity()) {
       ++counters_.bytes_dropped;  // a full UART ring: the byte is lost, as on hardware
       return;
     }
@@ -68,16 +74,18 @@ class GrblProtocol final : public CncProtocol {
 
   void poll(double now_s) override {
     report_alarm_change();
-    while (!stalled_) {
+    finish_dwell();
+    while (!stalled_ && !awaiting_dwell_) {
       if (!take_line(now_s)) break;
       report_alarm_change();
+      finish_dwell();
     }
   }
 
   std::string take_output() override { return std::exchange(out_, {}); }
   void set_stalled(bool stalled) override { stalled_ = stalled; }
   void external_reset(double now_s) override { soft_reset(now_s); }
-  std::size_t rx_free() const override { return params_.rx_buffer_bytes - rx_.size(); }
+  std::size_t rx_free() const override { return rx_capacity() - rx_.size(); }
   const ProtocolCounters& counters() const override { return counters_; }
 
  private:
@@ -135,12 +143,47 @@ class GrblProtocol final : public CncProtocol {
       // sender cannot run the rest of a program whose earlier line failed.
       answer(last_error_);
     } else {
-      const GrblStatus status = machine_.submit_line(line, now_s);
-      if (status == GrblStatus::ok) track_modal(line);
-      report_alarm_change();  // a soft-limit target: ALARM:2 first, then the line's error:10
-      answer(static_cast<int>(status));
+      execute_gcode(line, now_s);
     }
     return true;
+  }
+
+  // grblHAL's serial ring buffer (RX_BUFFER_SIZE bytes) tells a full ring from an empty one by
+  // keeping one slot free: it holds size − 1 bytes, and serialRxFree reports
+  // (RX_BUFFER_SIZE − 1) − count. $I's [OPT:] still names the size.
+  std::size_t rx_capacity() const { return params_.rx_buffer_bytes > 0 ? params_.rx_buffer_bytes - 1 : 0; }
+
+  // The dwell's `ok` comes when mc_dwell returns, after the dwell. A reset or an alarm (grblHAL
+  // aborts: sys.abort ends delay_sec) drops the line unanswered.
+  void finish_dwell() {
+    if (!awaiting_dwell_ || machine_.pending(*awaiting_dwell_)) {
+      if (awaiting_dwell_ && has_complete_line()) machine_.expect_line_after_dwell();
+      return;
+    }
+    awaiting_dwell_.reset();
+    if (!machine_.alarm()) answer(0);
+  }
+  bool has_complete_line() const {
+    return std::any_of(rx_.begin(), rx_.end(), [](char c) { return c == '\n' || c == '\r'; });
+  }
+
+  // Runs an accepted G-code line and answers it — at once, or (a dwell) when it is done.
+  void execute_gcode(const std::string& line, double now_s) {
+    const GrblStatus status = machine_.submit_line(line, now_s);
+    report_alarm_change();  // a soft-limit target: ALARM:2 first, then the line's error:10
+    if (status != GrblStatus::ok) {
+      answer(static_cast<int>(status));
+      return;
+    }
+    const ParseResult parsed = parse_block(line, ParseParams{});
+    track_modal(parsed);
+    if (parsed.block.motion == MotionMode::dwell && machine_.pending(machine_.accepted_blocks())) {
+      awaiting_dwell_ = machine_.accepted_blocks();
+      return;
+    }
+    // gc_execute_block's program end reports Message_ProgramEnd before the line's ok.
+    if (parsed.block.program_end) out_ += fmt::format("[MSG:Pgm End]{}", grbl::kEol);
+    answer(0);
   }
 
   // `ok`, or `error:N`; every answer also sets grblHAL's gc_state.last_error.
@@ -169,7 +212,7 @@ class GrblProtocol final : public CncProtocol {
     } else if (cmd == "$I") {
       out_ += grbl::build_info(planner_blocks_, params_.rx_buffer_bytes);
     } else if (cmd == "$G") {
-      out_ += grbl::parser_state(modal_, machine_.jet_commanded());
+      out_ += grbl::parser_state(modal_, machine_.accessories());
     } else if (cmd == "$$") {
       out_ += grbl::settings_dump();
     } else if (cmd == "$X") {
@@ -196,6 +239,7 @@ class GrblProtocol final : public CncProtocol {
     last_eol_ = 0;
     last_error_ = 0;
     modal_ = {};
+    awaiting_dwell_.reset();  // the dwell's line dies unanswered with the reset
     on_connect(now_s);
   }
 
@@ -213,8 +257,7 @@ class GrblProtocol final : public CncProtocol {
   }
 
   // Keeps what `$G` shows; parse_block is the same parser the machine uses.
-  void track_modal(const std::string& line) {
-    const ParseResult parsed = parse_block(line, ParseParams{});
+  void track_modal(const ParseResult& parsed) {
     if (parsed.status != GrblStatus::ok) return;
     const Block& b = parsed.block;
     if (b.motion != MotionMode::none && b.motion != MotionMode::dwell) modal_.motion = b.motion;
@@ -222,6 +265,10 @@ class GrblProtocol final : public CncProtocol {
     if (b.set_relative) modal_.relative = *b.set_relative;
     if (b.set_inverse_time) modal_.inverse_time = *b.set_inverse_time;
     if (b.feed_word) modal_.feed = *b.feed_word;
+    if (b.program_end) {  // gc_execute_block's program end: G1 G90 G94
+      modal_.motion = MotionMode::linear;
+      modal_.relative = modal_.inverse_time = false;
+    }
   }
 
   // grblHAL's LINE_BUFFER_SIZE is 257 with the terminator: longer lines answer error:11.
@@ -239,6 +286,8 @@ class GrblProtocol final : public CncProtocol {
   std::uint64_t ok_index_ = 0;
   std::optional<GrblAlarm> reported_alarm_;
   grbl::ModalView modal_;
+  grbl::StatusReporter reporter_;
+  std::optional<std::uint64_t> awaiting_dwell_;  // seq of the dwell whose ok is still due
 };
 
 }  // namespace

@@ -29,16 +29,33 @@ struct ModalView {
   double feed = 0;  // last F word, in the program's units
 };
 
-// `<Idle|MPos:…|Bf:…|Ln:…|FS:…,0>` — fields as grblHAL's report_realtime_status with
-// $10 = machine position + buffer state, line numbers and feed/speed enabled.
-std::string status_report(const Machine& machine, std::size_t rx_free_bytes, double now_s);
+// `<Idle|MPos:…|Bf:…|Ln:…|FS:…,0|WCO:…|Ov:…|A:…>` — grblHAL's report_realtime_status with
+// $10 = machine position, buffer state, line numbers, feed/speed, work offset and overrides.
+// Stateful as grblHAL is: WCO and Ov come every few reports (report.c's wco_counter and
+// override_counter), A: with Ov while an output is on or in the report after it changed.
+class StatusReporter {
+ public:
+  // report_init_message: the banner zeroes both counters, so the next report has Ov.
+  void restart();
+  std::string report(const Machine& machine, std::size_t rx_free_bytes, double now_s);
+
+ private:
+  bool wco_due(bool busy, bool idle);
+  bool overrides_due(bool busy, bool wco_now);
+
+  int wco_counter_ = 0, override_counter_ = 0;
+  bool report_wco_ = false;          // sys.report.wco: WCO in the next report
+  bool report_accessories_ = false;  // sys.report.spindle / coolant: A: in the next report
+  Accessories last_accessories_;
+  std::uint64_t last_program_ends_ = 0;
+};
 
 // `$I`: [VER:], [OPT:<flags>,<planner blocks>,<rx bytes>,<axes>,<tools>], [AXS:], [NEWOPT:],
 // [FIRMWARE:] (grblHAL's extended form, compatibility level 0). No trailing ok.
 std::string build_info(std::size_t planner_blocks, std::size_t rx_buffer_bytes);
 
 // `$G`: [GC:G0 G54 G17 G21 G90 G94 M5 M9 T0 F0 S0]. No trailing ok.
-std::string parser_state(const ModalView& modal, bool jet_on);
+std::string parser_state(const ModalView& modal, const Accessories& accessories);
 
 // `$$`: the few settings a sender looks at. No trailing ok.
 std::string settings_dump();

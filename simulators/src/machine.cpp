@@ -1,10 +1,13 @@
 // The simulated CNC's executor: queue, modal state, feed hold, alarms, events.
 //
 // Behaviour where the header leaves room (all Grbl-like unless said):
-// - Only timed blocks (a move that goes somewhere, a dwell with P > 0) occupy the planner, as
-//   only motion does in grblHAL; zero-time lines still queue in program order (no capacity) so
-//   each one is logged when the machine reaches it. The running block keeps its planner slot
-//   until it finishes (Grbl frees a block when it is done), so free_blocks() counts it.
+// - Only moves that go somewhere occupy the planner, as only motion does in grblHAL; dwells and
+//   zero-time lines still queue in program order (no capacity) so each one is logged when the
+//   machine reaches it. The running block keeps its planner slot until it finishes (Grbl frees
+//   a block when it is done), so free_blocks() counts it.
+// - A dwell runs after the drain its planner sync asks for, as grblHAL's mc_dwell
+//   (protocol_buffer_synchronize, then delay_sec): nothing else is planned while it runs, so Bf
+//   shows every block free. Its `ok` waits for its end — that is the grbl protocol's business.
 // - A block starts when the previous one ended, or at its submit time if the queue had run dry,
 //   or at the cycle-start time after a hold.
 // - Feed hold in Idle enters Hold at once (Grbl 1.1 too); lines sent then wait for `~`. A hold
@@ -12,7 +15,8 @@
 //   still decelerating is ignored, as in Grbl (hold must be complete).
 // - Modal changes (G20, G91, F…) act when the line is accepted, like Grbl's parser state; the
 //   jet M-codes and M2/M30 act when their block starts executing.
-// - M2/M30 (Grbl's program end): G1, G90, G94 and jet off; units and F stay (Grbl keeps them).
+// - M2/M30 (Grbl's program end): G1, G90, G94, jet, spindle and coolant off; units and F stay
+//   (Grbl keeps them).
 // - reset() returns true only when an axis was moving (cruising or decelerating), not during a
 //   dwell or a completed hold.
 // - Soft-limit alarms report the seq the refused line would have had (accepted_blocks() + 1),
@@ -31,15 +35,25 @@ namespace lamina::sim {
 Machine::Machine(MachineConfig config) : config_(std::move(config)) {}
 
 namespace {
-// Occupies a planner slot: grblHAL plans a block only for a move that goes somewhere (an empty
-// move is dropped by plan_buffer_line). Simplification: a dwell takes a slot too (after the
-// drain syncs() asks for), where grblHAL dwells outside the planner; the timeline is the same.
+// Takes time (a move or a dwell): the machine is busy with the program while it runs.
 bool is_timed(const detail::PlannedBlock& b) { return b.duration_s > 0; }
+// Occupies a planner slot: grblHAL plans a block only for a move that goes somewhere (an empty
+// move is dropped by plan_buffer_line); a dwell runs in mc_dwell, outside the planner.
+bool occupies_planner(const detail::PlannedBlock& b) { return is_timed(b) && b.kind != MotionMode::dwell; }
 // grblHAL synchronises with the planner (protocol_buffer_synchronize) before a spindle — here
-// the jet — change, a program end and a dwell: the line waits unanswered until every motion
-// before it is done, so the machine stands still when the jet turns on or off.
+// the jet — change (spindle_sync), a coolant change (coolant_sync), a program end and a dwell
+// (mc_dwell): the line waits unanswered until every motion before it is done, so the machine
+// stands still when the jet turns on or off.
 bool syncs(const detail::PlannedBlock& b) {
-  return b.jet_on.has_value() || b.program_end || b.kind == MotionMode::dwell;
+  return b.jet_on.has_value() || b.spindle.has_value() || b.coolant.has_value() || b.program_end ||
+         b.kind == MotionMode::dwell;
+}
+void apply_coolant(CoolantCommand c, Accessories& a) {
+  switch (c) {
+    case CoolantCommand::mist: a.mist = true; break;
+    case CoolantCommand::flood: a.flood = true; break;
+    case CoolantCommand::off: a.mist = a.flood = false; break;
+  }
 }
 }  // namespace
 
@@ -76,7 +90,7 @@ GrblStatus Machine::submit_line(std::string_view line, double now_s) {
     alarm_stop(GrblAlarm::soft_limit, now_s, accepted_ + 1);
     return GrblStatus::soft_limit;
   }
-  if (is_timed(planned) && !has_room()) return GrblStatus::overflow;
+  if (occupies_planner(planned) && !has_room()) return GrblStatus::overflow;
   modal_ = p.modal;
   planned.seq = ++accepted_;
   planned.line = std::string(line);
@@ -102,7 +116,7 @@ bool Machine::has_room_for(std::string_view line) const {
     draining_for_sync_ = true;  // the queue runs dry on purpose: no starvation
     return false;
   }
-  return has_room() || !is_timed(*p.block);
+  return has_room() || !occupies_planner(*p.block);
 }
 std::size_t Machine::free_blocks() const {
   const std::size_t used = queued_timed_blocks();
@@ -110,8 +124,8 @@ std::size_t Machine::free_blocks() const {
 }
 std::size_t Machine::queued_blocks() const { return queue_.size() + (running_ ? 1 : 0); }
 std::size_t Machine::queued_timed_blocks() const {
-  const auto queued = std::count_if(queue_.begin(), queue_.end(), is_timed);
-  return static_cast<std::size_t>(queued) + (running_ && is_timed(running_->block) ? 1 : 0);
+  const auto queued = std::count_if(queue_.begin(), queue_.end(), occupies_planner);
+  return static_cast<std::size_t>(queued) + (running_ && occupies_planner(running_->block) ? 1 : 0);
 }
 std::size_t Machine::planner_blocks() const { return config_.planner_blocks; }
 
@@ -183,8 +197,12 @@ void Machine::start_next(double t_s) {
     return;
   }
   if (r.block.jet_on) jet_ = *r.block.jet_on;
+  if (r.block.spindle) accessories_.spindle = *r.block.spindle;
+  if (r.block.coolant) apply_coolant(*r.block.coolant, accessories_);
   if (r.block.program_end) {
     jet_ = false;
+    accessories_ = {};  // grblHAL's program end: spindle_all_off, coolant off
+    ++program_ends_;
     program_running_ = !queue_.empty();  // lines already queued behind M2 start the next program
   }
   running_ = std::move(r);
@@ -239,6 +257,7 @@ void Machine::stop_running(double t_s) {
 void Machine::reset_modal() {
   modal_ = detail::ModalState{};
   jet_ = false;
+  accessories_ = {};
   held_ = false;
   program_running_ = false;
   moved_in_program_ = false;
@@ -353,10 +372,22 @@ double Machine::feed_mm_per_min(double now_s) const {
   return running_->block.feed_mm_per_min;
 }
 
+// grblHAL's Ln is the current planner block's: none while dwelling (mc_dwell plans nothing).
 std::optional<std::int64_t> Machine::line_number() const {
-  if (!running_) return std::nullopt;
+  if (!running_ || running_->block.kind == MotionMode::dwell) return std::nullopt;
   return running_->block.line_number;
 }
+
+bool Machine::dwelling() const { return running_ && running_->block.kind == MotionMode::dwell; }
+bool Machine::pending(std::uint64_t seq) const {
+  if (running_ && running_->block.seq == seq) return true;
+  return std::any_of(queue_.begin(), queue_.end(), [seq](const detail::PlannedBlock& b) { return b.seq == seq; });
+}
+void Machine::expect_line_after_dwell() {
+  if (dwelling()) draining_for_sync_ = true;
+}
+Accessories Machine::accessories() const { return accessories_; }
+std::uint64_t Machine::program_ends() const { return program_ends_; }
 
 std::uint64_t Machine::accepted_blocks() const { return accepted_; }
 std::uint64_t Machine::executed_blocks() const { return executed_; }

@@ -15,8 +15,11 @@
 namespace lamina::sim {
 
 struct MachineConfig {
-  AxisValues soft_min{0, 0, -150, -120, -1e9};  // mm, mm, mm, deg, deg
-  AxisValues soft_max{3000, 2000, 50, 120, 1e9};
+  // The travel of config/sim-machine.toml (the cell config/machine.toml describes, pivot
+  // coordinates included: a tilted head's pivot goes past the table on every side), so a plain
+  // lamina-sim runs Lamina's own programs. MachineDefaults.MatchTheSimMachineFile keeps them equal.
+  AxisValues soft_min{-200, -200, -200, -120, -1e9};  // mm, mm, mm, deg, deg
+  AxisValues soft_max{2700, 1450, 200, 120, 1e9};
   bool soft_limits = true;
   AxisValues rapid_per_min{20000, 20000, 5000, 7200, 7200};  // mm/min or deg/min per axis
   double max_feed_mm_per_min = 20000;       // feeds above are clamped, as a controller does
@@ -25,6 +28,9 @@ struct MachineConfig {
   // lines (comments, modal-only lines, M-codes) take none: grblHAL executes them in its parser
   // and never plans a block for them.
   std::size_t planner_blocks = 100;
+  // G28's stored position in machine coordinates (grblHAL's G28 data, zero until G28.1 — which
+  // the simulator does not implement — sets it).
+  AxisValues g28_position{};
   ParseParams parse;
   // Fault injection: raise `alarm_code` when block number `alarm_at_seq` (1-based count of
   // accepted blocks) starts executing.
@@ -33,6 +39,13 @@ struct MachineConfig {
 };
 
 enum class MachineState { idle, run, hold_pending, hold, alarm };
+
+// The spindle and coolant outputs as they are now (grblHAL's accessory state, the `A:` field).
+struct Accessories {
+  SpindleCommand spindle = SpindleCommand::off;
+  bool flood = false, mist = false;
+  bool operator==(const Accessories&) const = default;
+};
 
 // One block the machine executed (or started and was cut short by a reset or an alarm).
 struct ExecutedBlock {
@@ -77,7 +90,10 @@ struct PlannedBlock {
   double path_length = 0;       // mm (deg for a rotary-only move); hold deceleration runs on it
   double feed_mm_per_min = 0;   // effective feed reported while it runs
   double center_x = 0, center_y = 0, radius = 0, start_angle = 0, sweep = 0;  // arcs (rad)
+  std::optional<AxisValues> via;  // G28's intermediate point: two straight legs, start → via → target
   std::optional<bool> jet_on;
+  std::optional<SpindleCommand> spindle;
+  std::optional<CoolantCommand> coolant;
   bool program_end = false;
 };
 }  // namespace detail
@@ -97,14 +113,15 @@ class Machine {
   // Capacity is planner_blocks timed blocks (motion with a non-zero length and dwell with a
   // non-zero time); the running one keeps its slot until it finishes (Grbl).
   // has_room(): a timed block would fit. has_room_for(line): the line may be taken now — a
-  // timed block needs a free slot (a zero-time line does not); a jet M-code, M2/M30 and a dwell
-  // wait until the queue is empty (grblHAL's planner sync); a line with an error or a
-  // soft-limit target is answered at once, as grblHAL checks them before waiting.
+  // motion block needs a free slot (a zero-time line does not); a jet, spindle or coolant
+  // M-code, M2/M30 and a dwell wait until the queue is empty (grblHAL's planner sync); a line
+  // with an error or a soft-limit target is answered at once, as grblHAL checks them before
+  // waiting. A dwell takes no planner slot: grblHAL dwells in mc_dwell, outside the planner.
   bool has_room() const;
   bool has_room_for(std::string_view line) const;
   std::size_t free_blocks() const;          // planner_blocks − queued_timed_blocks(): Grbl's Bf
   std::size_t queued_blocks() const;        // every queued line, zero-time ones and the running one included
-  std::size_t queued_timed_blocks() const;  // the ones that occupy the planner
+  std::size_t queued_timed_blocks() const;  // the ones that occupy the planner (motion; not a dwell)
   std::size_t planner_blocks() const;       // the configured capacity ($I)
 
   // Run the time model up to now_s: finish blocks, start the next ones, emit events.
@@ -132,7 +149,16 @@ class Machine {
   std::uint64_t executed_blocks() const;           // blocks finished
   std::uint64_t starvation_count() const;
   bool jet_commanded() const;                      // CNC jet output (M-code) right now
+  Accessories accessories() const;                 // spindle / coolant outputs right now
+  std::uint64_t program_ends() const;              // M2/M30 executed since start
   std::optional<GrblAlarm> alarm() const;
+  // A dwell is running (held or not). grblHAL reports Idle meanwhile: no motion is planned.
+  bool dwelling() const;
+  // Block `seq` is queued or running (false once it finished or a reset / alarm flushed it).
+  bool pending(std::uint64_t seq) const;
+  // The controller holds a line it takes as soon as the running dwell ends (grblHAL parses the
+  // next line only when mc_dwell returns): the queue then runs dry on purpose, no starvation.
+  void expect_line_after_dwell();
 
   // Events since the last call, in order (for the execution log and the protocols).
   std::vector<MachineEvent> take_events();
@@ -179,11 +205,13 @@ class Machine {
   std::optional<GrblAlarm> alarm_;
   bool estop_ = false;
   bool jet_ = false;
+  Accessories accessories_;
+  std::uint64_t program_ends_ = 0;
   bool program_running_ = false;
   bool moved_in_program_ = false;  // a timed block (motion, dwell) ran in this program
   bool starved_ = false;      // starvation already reported for this empty period
-  // A jet change, program end or dwell waits for the queue to drain (has_room_for said no):
-  // that empty queue is the program's own stop, not starvation.
+  // A jet change, program end or dwell waits for the queue to drain (has_room_for said no), or
+  // a line waits behind a dwell: that empty queue is the program's own stop, not starvation.
   mutable bool draining_for_sync_ = false;
   std::optional<StarvationEvent> pending_stop_;  // the queue ran dry here; starvation unless a block comes at once
   double last_motion_end_s_ = -1;                // when the last timed block ended

@@ -47,7 +47,7 @@ int main(int argc, char** argv) {
   std::optional<double> heartbeat_timeout_ms;
   std::size_t rx_buffer = 0, planner_blocks = 0;
   bool no_soft_limits = false;
-  std::string on_open = "banner";
+  std::string on_open = "quiet";
   app.add_option("--personality", o.personality, "grbl (character counting) or xonxoff (Fanuc drip feed)")
       ->check(CLI::IsMember({"grbl", "xonxoff"}));
   app.add_option("--link", o.link_path, "make a PTY and symlink its slave here");
@@ -58,7 +58,7 @@ int main(int argc, char** argv) {
   app.add_option("--baud", o.baud, "emulated line speed, 8N1 (default 115200)");
   app.add_option("--time-scale", o.time_scale, "run the machine K times faster than real time");
   app.add_option("--on-open", on_open,
-                 "when a client opens the port: banner (default), reset (a classic Grbl's DTR reset) or quiet")
+                 "when a client opens the port: quiet (default: native-USB grblHAL says nothing), banner, or reset (a classic Grbl's DTR reset)")
       ->check(CLI::IsMember({"banner", "reset", "quiet"}));
   app.add_option("--rx-buffer", rx_buffer, "controller receive buffer in bytes (grbl 1024, classic Grbl 128)");
   app.add_option("--planner-blocks", planner_blocks, "planner queue length in blocks (default 100)");
@@ -84,7 +84,7 @@ int main(int argc, char** argv) {
 
   try {
     if (!machine_file.empty()) apply_machine_file(machine_file, o);
-    o.on_open = on_open == "reset" ? OnOpen::reset : on_open == "quiet" ? OnOpen::quiet : OnOpen::banner;
+    o.on_open = on_open == "reset" ? OnOpen::reset : on_open == "banner" ? OnOpen::banner : OnOpen::quiet;
     if (rx_buffer) o.grbl.rx_buffer_bytes = o.xonxoff.buffer_bytes = rx_buffer;
     if (o.personality == "xonxoff") {  // water marks follow the buffer: DC3 at ¾, DC1 at ¼
       o.xonxoff.high_water_bytes = o.xonxoff.buffer_bytes * 3 / 4;

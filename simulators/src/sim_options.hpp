@@ -27,11 +27,13 @@ struct FaultSchedule {
 
 // What the controller does when a client opens its port. Boards differ, and a host must cope
 // with each: a classic Grbl on an Arduino reboots when DTR rises (motion stops, queue lost,
-// banner); a controller on native USB or Ethernet does not notice the open at all.
+// banner); a grblHAL controller on native USB or Ethernet does not notice the open at all — it
+// prints its banner at boot and after a reset only (report_init_message), so a host that opens
+// the port later hears nothing until it asks.
 enum class OnOpen {
-  banner,  // the banner, nothing else changes (the default: a host sees the controller is there)
+  banner,  // the banner, nothing else changes (a board whose USB bridge replays it)
   reset,   // a reset as DTR gives a classic Grbl: motion stops, queue and buffer flushed, banner
-  quiet,   // nothing: the controller keeps running and says nothing until asked
+  quiet,   // nothing (the default, native-USB grblHAL): it keeps running and says nothing until asked
 };
 
 struct SimOptions {
@@ -43,7 +45,7 @@ struct SimOptions {
   std::string log_path;
   double baud = 115200;
   double time_scale = 1;
-  OnOpen on_open = OnOpen::banner;
+  OnOpen on_open = OnOpen::quiet;
   MachineConfig machine;
   GrblParams grbl;
   XonXoffParams xonxoff;

@@ -130,7 +130,10 @@ void SimRuntime::step() {
   switch (port_->update()) {
     case PortChange::client_connected:
       log_.write_event("connect", now, {{"on_open", on_open_name(options_.on_open)}});
+      // What the controller said before the host opened the port (the power-up banner
+      // included) went nowhere, as on native USB before the host enumerates it.
       tx_pending_.clear();
+      protocol_->take_output();
       switch (options_.on_open) {
         case OnOpen::banner: protocol_->on_connect(now); break;
         case OnOpen::reset:  // the reset prints the banner itself (after ALARM:3 if it was moving)

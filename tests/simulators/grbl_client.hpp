@@ -21,6 +21,10 @@ struct StreamResult {
   bool finished = false;
 };
 
+// What grblHAL's 1024-byte receive ring holds: one slot stays free to tell full from empty, so
+// Bf reports 1023 free at most (while $I's [OPT:] names 1024). A sender that fills 1024 loses a byte.
+inline constexpr std::size_t kGrblHalRxBytes = 1023;
+
 // Send `lines` with at most `rx_bytes` unacknowledged bytes in flight. Stops on an alarm, on
 // a closed link, or after `timeout_s`.
 inline StreamResult stream_counting(StreamClient& link, const std::vector<std::string>& lines, std::size_t rx_bytes,

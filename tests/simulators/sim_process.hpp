@@ -225,6 +225,16 @@ class StreamClient {
   bool closed_ = false;
 };
 
+// A native-USB grblHAL (lamina-sim's default --on-open quiet) says nothing when a host opens
+// its port: ask for a status report (a real-time byte, no line, no ok) to know it is there.
+// The answer is dropped from the buffer.
+inline bool wait_controller(StreamClient& c, double wait_s = 3.0) {
+  c.send("?");
+  const bool there = c.wait_for(">\r\n", wait_s);
+  c.buffer().clear();
+  return there;
+}
+
 // Run lamina-sim to its exit (for start-up errors): exit status and everything it printed.
 struct SimExit {
   int status = -1;

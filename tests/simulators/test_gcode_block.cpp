@@ -62,8 +62,12 @@ TEST(GcodeBlock, JetMcodesFollowTheConfiguration) {
   custom.jet_off_mcodes = {63};
   EXPECT_EQ(parse("M62", custom).block.jet_on, std::optional<bool>(true));
   EXPECT_EQ(parse("M63", custom).block.jet_on, std::optional<bool>(false));
-  EXPECT_EQ(status("M3", custom), GrblStatus::unsupported_command);  // not configured there
-  EXPECT_EQ(status("M8"), GrblStatus::unsupported_command);
+  // M3 stays grblHAL's spindle command (accepted), but it is not this machine's jet.
+  EXPECT_EQ(parse("M3", custom).block.jet_on, std::nullopt);
+  EXPECT_EQ(parse("M3", custom).block.spindle, std::optional<SpindleCommand>(SpindleCommand::cw));
+  EXPECT_EQ(parse("M4").block.jet_on, std::optional<bool>(true));  // by default M4 is the jet too
+  EXPECT_EQ(parse("M8").block.coolant, std::optional<CoolantCommand>(CoolantCommand::flood));
+  EXPECT_EQ(status("M62"), GrblStatus::unsupported_command);  // not configured by default
   EXPECT_TRUE(parse("M2").block.program_end);
   EXPECT_TRUE(parse("M30").block.program_end);
 }
@@ -92,11 +96,15 @@ TEST(GcodeBlock, DwellPercentAndModalWords) {
   EXPECT_EQ(parse("G3X1R2").block.motion, MotionMode::arc_ccw);
 }
 
-TEST(GcodeBlock, AxisLetterTheMachineHasNotIsError20) {
-  EXPECT_EQ(status("G1B10F100"), GrblStatus::unsupported_command);
-  EXPECT_EQ(static_cast<int>(status("G1 B10 F100")), 20);
-  EXPECT_EQ(status("E5"), GrblStatus::unsupported_command);
-  EXPECT_EQ(status("G1 U1"), GrblStatus::unsupported_command);
+// grblHAL keeps a letter without an axis as a parameter word; the executor answers
+// unused_words (36) for it after its other checks (Machine tests cover the answer).
+TEST(GcodeBlock, LetterWithoutAnAxisIsAnUnusedValueWord) {
+  EXPECT_EQ(status("G1B10F100"), GrblStatus::ok);
+  EXPECT_TRUE(parse("G1 B10 F100").block.unused_word);
+  EXPECT_TRUE(parse("E5").block.unused_word);
+  EXPECT_TRUE(parse("G1 U1").block.unused_word);
+  EXPECT_FALSE(parse("G1 X1 A2 C3").block.unused_word);
+  EXPECT_EQ(status("G1 Bx"), GrblStatus::bad_number_format);  // the number is read first
   EXPECT_EQ(status("G38"), GrblStatus::unsupported_command);
   EXPECT_EQ(status("T1 S1000"), GrblStatus::ok);  // accepted and ignored
 }

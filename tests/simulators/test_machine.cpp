@@ -243,7 +243,7 @@ TEST(Machine, ResetStopsFlushesAndResetsModalState) {
 TEST(Machine, SoftLimitAlarmThenErrorLockUntilUnlock) {
   Machine m({});
   ok(m, "G1X10F600", 0);
-  EXPECT_EQ(m.submit_line("G0X-1", 0.5), GrblStatus::soft_limit);  // soft_min X is 0
+  EXPECT_EQ(m.submit_line("G0X-201", 0.5), GrblStatus::soft_limit);  // soft_min X is -200
   EXPECT_EQ(m.state(), MachineState::alarm);
   EXPECT_EQ(m.alarm(), std::optional<GrblAlarm>(GrblAlarm::soft_limit));
   const auto events = m.take_events();
@@ -262,7 +262,7 @@ TEST(Machine, SoftLimitAlarmThenErrorLockUntilUnlock) {
   MachineConfig off;
   off.soft_limits = false;
   Machine free_machine(off);
-  ok(free_machine, "G0X-1", 0);
+  ok(free_machine, "G0X-201", 0);
 }
 
 TEST(Machine, EstopHoldsTheAlarm) {
@@ -461,7 +461,9 @@ TEST(Machine, OnlyMovesAreCheckedAgainstSoftLimits) {
 }
 
 TEST(Machine, ArcBulgingPastALimitIsRefused) {
-  Machine m({});
+  MachineConfig y_from_zero;
+  y_from_zero.soft_min[1] = 0;
+  Machine m(y_from_zero);
   ok(m, "G0X10Y5", 0);
   // CCW half circle (10,5) → (30,5) around (20,5) goes below through (20,-5): Y < 0.
   EXPECT_EQ(m.submit_line("G3X30Y5I10J0F600", 1), GrblStatus::soft_limit);

@@ -13,7 +13,7 @@ struct FaultSim : LoggedSim {
   explicit FaultSim(std::vector<std::string> extra) : LoggedSim(std::move(extra)) {}
   StreamClient connect() {
     StreamClient c = StreamClient::open_pty(link);
-    if (!c.wait_for("Grbl", 3.0)) throw std::runtime_error("no banner");
+    if (!wait_controller(c)) throw std::runtime_error("no status report");
     c.buffer().clear();
     return c;
   }
@@ -61,7 +61,7 @@ TEST(SimFaults, GarbledBytesReachTheControllerChanged) {
   StreamClient c = s.connect();
   const auto program = five_axis_program(300);
   // A garbled end of line merges two lines: one answer never comes, so the sender stalls (5 s).
-  const StreamResult r = stream_counting(c, program, 1024, 5);
+  const StreamResult r = stream_counting(c, program, kGrblHalRxBytes, 5);
   const auto st = control_status(s.sim.control_port());
   ASSERT_GT(st["bytes_garbled"].get<int>(), 0);
   EXPECT_EQ(s.events("garble").size(), st["bytes_garbled"].get<std::size_t>());
@@ -77,7 +77,7 @@ TEST(SimFaults, UnplugAtLineClosesTheLinkAndReplugBringsANewOne) {
   FaultSim s({"--unplug-at-line", "40", "--replug-after", "300", "--time-scale", "20"});
   StreamClient c = s.connect();
   const auto program = five_axis_program(200);
-  const StreamResult r = stream_counting(c, program, 1024, 10);
+  const StreamResult r = stream_counting(c, program, kGrblHalRxBytes, 10);
   EXPECT_TRUE(c.closed()) << "the client sees the line drop";
   EXPECT_LE(r.oks, 40u);
   const auto st = control_status(s.sim.control_port());
@@ -85,14 +85,14 @@ TEST(SimFaults, UnplugAtLineClosesTheLinkAndReplugBringsANewOne) {
   ASSERT_EQ(s.events("unplug").size(), 1u);
   ASSERT_TRUE(wait_status(s.sim.control_port(), [](const nlohmann::json& x) { return x["plugged"] == true; }, 3));
   StreamClient again = StreamClient::open_pty(s.link);
-  EXPECT_TRUE(again.wait_for("Grbl", 3.0)) << "a new port at the same path, with a banner";
+  EXPECT_TRUE(wait_controller(again)) << "a new port at the same path, and the controller on it";
 }
 
 TEST(SimFaults, AlarmAtLineStopsThereAndLocks) {
   FaultSim s({"--alarm-at-line", "20", "--time-scale", "20"});
   StreamClient c = s.connect();
   const auto program = five_axis_program(100);
-  const StreamResult r = stream_counting(c, program, 1024, 20);
+  const StreamResult r = stream_counting(c, program, kGrblHalRxBytes, 20);
   ASSERT_EQ(r.alarms.size(), 1u) << c.buffer();
   EXPECT_EQ(r.alarms[0], "ALARM:1");
   const auto alarms = s.events("alarm");

@@ -64,9 +64,8 @@ TEST(SimRunsOurPosts, GrblhalProgramStreamedByCharacterCounting) {
   SimProcess sim({"--link", dir.file("cnc"), "--log", dir.file("exec.jsonl"), "--control", "127.0.0.1:0",
                   "--time-scale", fmt::format("{}", kTimeScale)});
   StreamClient c = StreamClient::open_pty(dir.file("cnc"));
-  ASSERT_TRUE(c.wait_for("Grbl", 3.0));
-  c.buffer().clear();
-  const StreamResult r = stream_counting(c, sheet.lines, 1024, 120);
+  ASSERT_TRUE(wait_controller(c));
+  const StreamResult r = stream_counting(c, sheet.lines, kGrblHalRxBytes, 120);
   ASSERT_TRUE(r.finished) << r.oks << " of " << sheet.lines.size();
   ASSERT_TRUE(r.errors.empty()) << r.errors.front();
   ASSERT_TRUE(wait_status(sim.control_port(), [&](const nlohmann::json& st) {
