@@ -60,6 +60,7 @@ void apply_machine_file(const std::string& path, SimOptions& options) {
     const std::string key(key_node.str());
     if (key == "soft_min") m.soft_min = read_axes(path, key, node);
     else if (key == "soft_max") m.soft_max = read_axes(path, key, node);
+    else if (key == "g28_position") m.g28_position = read_axes(path, key, node);
     else if (key == "soft_limits") {
       const auto v = node.value<bool>();
       if (!v) throw std::runtime_error(fmt::format("{}: soft_limits must be true or false", where(path, node)));
@@ -76,7 +77,7 @@ void apply_machine_file(const std::string& path, SimOptions& options) {
     else if (key == "jet_off_mcodes") m.parse.jet_off_mcodes = read_codes(path, key, node);
     else if (key == "pressure_ramp_s") options.plc.pressure_ramp_s = read_positive(path, key, node);
     else
-      throw std::runtime_error(fmt::format("{}: unknown key '{}' (known: soft_min soft_max soft_limits "
+      throw std::runtime_error(fmt::format("{}: unknown key '{}' (known: soft_min soft_max g28_position soft_limits "
                                            "rapid_per_min max_feed_mm_per_min hold_decel_mm_per_s2 "
                                            "planner_blocks rx_buffer jet_on_mcodes jet_off_mcodes pressure_ramp_s)",
                                            where(path, node), key));
