@@ -34,6 +34,7 @@ struct StreamOptions {
   int baud = 115200;
   std::size_t rx_buffer = 0;
   double status_hz = 5;
+  double stall_margin_s = 2;
   bool json = false;
   bool resume = false;  // resume automatically after a stop? never: only the keyboard's R
 };
@@ -93,6 +94,7 @@ int run_stream(const StreamOptions& o) {
     else protocol = drivers::make_xonxoff_protocol();
     drivers::StreamerSettings settings;
     settings.status_period_s = o.protocol == "xonxoff" ? 0 : 1.0 / o.status_hz;
+    settings.stall_margin_s = o.stall_margin_s;
     drivers::TransportFactory open;
     if (!o.port.empty()) {
       drivers::SerialSettings serial;
@@ -109,6 +111,13 @@ int run_stream(const StreamOptions& o) {
       drivers::CellIoSettings cs;
       std::tie(cs.plc.host, cs.plc.port) = split_host_port(o.modbus, "--modbus");
       cell = std::make_unique<drivers::CellIo>(cs);
+    } else if (o.protocol == "xonxoff") {
+      // Without the PLC's jet output, a stop can only hold the feed; a drip feed has no reset
+      // on its line that would turn the controller's jet M-code off.
+      spdlog::warn("no --modbus: on a stop nothing turns the jet off (a drip feed has no reset on its line); "
+                   "use the cell's PLC");
+    } else {
+      spdlog::info("no --modbus: on a stop the controller is soft-reset once it stands still, to turn the jet off");
     }
   }
 
@@ -189,6 +198,9 @@ void add_stream_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--rx-buffer", o->rx_buffer, "the controller's receive buffer (default: as it reports)");
   cmd->add_option("--modbus", o->modbus, "the cell PLC, HOST:PORT (and the mailbox for --protocol modbus)");
   cmd->add_option("--status-hz", o->status_hz, "status polls per second")->check(CLI::Range(0.5, 50.0));
+  cmd->add_option("--stall-margin", o->stall_margin_s,
+                  "seconds Idle with lines unanswered (plus a dwell's P) before the link calls it a stall")
+      ->check(CLI::Range(0.5, 600.0));
   cmd->add_flag("--json", o->json, "print the summary as JSON (no progress bar)");
   cmd->callback([o, &exit_code] { exit_code = run_stream(*o); });
 }

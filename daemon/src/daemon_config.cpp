@@ -172,7 +172,7 @@ constexpr std::array kRootKeys{"state_dir"sv};
 constexpr std::array kSections{"server"sv, "link"sv, "cell"sv, "planner"sv};
 constexpr std::array kServerKeys{"socket"sv, "socket_mode"sv, "socket_group"sv, "tcp"sv, "token"sv, "token_file"sv,
                                  "max_request_bytes"sv};
-constexpr std::array kLinkKeys{"protocol"sv, "port"sv, "tcp"sv, "baud"sv, "rx_buffer"sv, "status_hz"sv};
+constexpr std::array kLinkKeys{"protocol"sv, "port"sv, "tcp"sv, "baud"sv, "rx_buffer"sv, "status_hz"sv, "stall_margin_s"sv};
 constexpr std::array kCellKeys{"enabled"sv, "modbus"sv, "modbus_unit"sv, "modbus_timeout_s"sv,
                                "modbus_reconnects"sv, "heartbeat_period_s"sv, "pump_ready_timeout_s"sv,
                                "pressure_setpoint_mpa"sv, "abrasive_g_per_min"sv};
@@ -244,6 +244,7 @@ void read_link(Section s, MachineLinkConfig& c) {
   s.integer("baud", c.baud, 300, 4'000'000);
   s.integer("rx_buffer", c.rx_buffer, 0, 65536);
   s.number("status_hz", c.status_hz, {0.5, 50});
+  s.number("stall_margin_s", c.stall_margin_s, {0.5, 600});
 }
 
 void read_cell(Section s, CellConfig& c) {

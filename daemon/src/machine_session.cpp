@@ -51,6 +51,7 @@ MachineSession::MachineSession(const DaemonConfig& config) : link_config_(config
     else throw std::invalid_argument(fmt::format("[link] protocol '{}' is unknown", l.protocol));
     drivers::StreamerSettings settings;
     settings.status_period_s = l.protocol == "xonxoff" ? 0 : 1.0 / l.status_hz;
+    settings.stall_margin_s = l.stall_margin_s;
     drivers::TransportFactory open;
     if (!l.port.empty()) {
       drivers::SerialSettings serial;

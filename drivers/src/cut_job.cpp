@@ -251,6 +251,18 @@ CutReport CutJob::stream_from(std::size_t from, std::vector<std::string> preambl
   return report_;
 }
 
+// With no PLC the controller's own M-code is the only jet output, and a feed hold keeps it on:
+// the soft reset turns it off (grbl's mc_reset stops spindle and coolant). Done once the axes
+// stand still, so the reset costs no position; a controller that never reported still is reset
+// anyway — a jet on a standing machine drills the part, a lost position only needs homing.
+std::optional<LinkError> CutJob::jet_off_without_plc(bool axes_still) {
+  if (cell_ || !link_.can_reset()) return std::nullopt;
+  if (!axes_still) spdlog::warn("cut: the machine did not report standing still; resetting it anyway (jet off)");
+  if (auto error = link_.reset(settings_.stop_timeout_s))
+    return LinkError{error->code, "the soft reset that turns the jet off went unanswered (" + error->message + ")"};
+  return std::nullopt;
+}
+
 void CutJob::stop_safely(LinkError why) {
   stopping_ = true;
   set_state(CutState::stopping);
@@ -284,6 +296,7 @@ void CutJob::stop_safely(LinkError why) {
       have_executed = true;
     }
   }
+  const std::optional<LinkError> reset_failed = jet_off_without_plc(still.has_value());
   std::lock_guard lock(mutex_);
   std::size_t accepted = accepted_at_status_;
   std::size_t queued = queued_at_status_.value_or(program_.size());  // unknown: assume all may be queued
@@ -308,6 +321,7 @@ void CutJob::stop_safely(LinkError why) {
   // The controller often speaks first (ALARM, NAK) about what the PLC knows the cause of.
   if (cell_ && why.code != LinkErrorCode::interlock)
     if (const auto cell_fault = cell_->fault()) report_.reason->message += " (cell: " + cell_fault->message + ")";
+  if (reset_failed) report_.reason->message += "; " + reset_failed->message;
   report_.last_status = still ? still : report_.last_status;
   if (auto plan = plan_resume(program_, report_.first_unfinished_line, settings_.safe_z_mm)) {
     report_.resume = *plan;

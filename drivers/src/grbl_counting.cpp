@@ -108,6 +108,13 @@ class CountingProtocol final : public LineProtocol {
   std::string clear_error_lock() const override { return "\n"; }
   std::vector<std::string> unlock_lines() const override { return {"$X"}; }
 
+  std::optional<Unanswered> unanswered() const override {
+    Unanswered u;
+    u.bytes = in_flight_bytes_;
+    if (!in_flight_.empty()) u.oldest_line_bytes = in_flight_.front().bytes;
+    return u;
+  }
+
   std::size_t lines_sent() const override { return next_; }
   std::size_t lines_accepted() const override { return accepted_; }
   bool finished() const override { return accepted_ == span_.lines.size(); }

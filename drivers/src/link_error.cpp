@@ -16,6 +16,7 @@ const char* to_string(LinkErrorCode code) {
     case LinkErrorCode::modbus_error: return "modbus_error";
     case LinkErrorCode::cancelled: return "cancelled";
     case LinkErrorCode::bad_request: return "bad_request";
+    case LinkErrorCode::controller_held: return "controller_held";
   }
   return "unknown";
 }

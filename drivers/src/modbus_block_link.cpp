@@ -13,6 +13,7 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include "lamina/drivers/line_wait.hpp"
 #include "mailbox_codec.hpp"
 #include "modbus_client.hpp"
 #include "plc_map.hpp"
@@ -194,6 +195,7 @@ struct ModbusBlockLink::Impl {
       if (auto bad = check_mailbox_block(span.first_index + i, span.lines[i])) return finish(bad, span.first_index);
     if (auto r = begin_job(); !r) return finish(r.error(), span.first_index);
 
+    Clock::time_point dwell_ends{};  // when the last dwell the CNC took is over
     for (std::size_t i = 0; i < span.lines.size(); ++i) {
       const std::size_t index = span.first_index + i;
       const std::string& line = span.lines[i];
@@ -219,13 +221,15 @@ struct ModbusBlockLink::Impl {
       // The acknowledge. A CNC that is running or held has not lost the block: it takes a jet
       // M-code, a program end or a dwell only once its queue has drained (the planner sync),
       // which may take minutes of cutting, and a hold keeps it for as long as the operator
-      // likes. The timeout counts only while it stands idle with the block untaken.
-      auto deadline = Clock::now() + seconds(settings.ack_timeout_s);
+      // likes. The timeout counts only while it stands idle with the block untaken — and a
+      // controller that dwells stands idle on purpose: a dwell starts when its block is taken
+      // (after the drain), so until its P has passed no block behind it is overdue.
+      const auto ack_deadline = [&] { return std::max(Clock::now(), dwell_ends) + seconds(settings.ack_timeout_s); };
+      auto deadline = ack_deadline();
       while (true) {
         if (auto r = read_cnc(); !r) return finish(at_line(r.error(), index, line), span.first_index);
         if (cnc[pm::kInMailboxAck] == seq) break;
-        if (const int state = cnc[pm::kInCncState]; state >= 1 && state <= 3)
-          deadline = Clock::now() + seconds(settings.ack_timeout_s);
+        if (const int state = cnc[pm::kInCncState]; state >= 1 && state <= 3) deadline = ack_deadline();
         if (auto e = cnc_trouble(index, line)) return finish(e, span.first_index);
         if (auto e = stopped()) return finish(e, span.first_index);
         if (Clock::now() >= deadline)
@@ -237,6 +241,8 @@ struct ModbusBlockLink::Impl {
         serve_realtime();
         std::this_thread::sleep_for(kPollInterval);
       }
+      if (const double dwell_s = grbl_line_wait(line).dwell_s; dwell_s > 0)
+        dwell_ends = Clock::now() + seconds(dwell_s);
       std::lock_guard lock(mutex);
       ++progress.lines_accepted;
     }

@@ -1,5 +1,7 @@
 #include "lamina/drivers/streamer.hpp"
 
+#include "lamina/drivers/line_wait.hpp"
+
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -66,8 +68,17 @@ struct Streamer::Impl {
   bool awaiting_banner = false;
   Clock::time_point connected_at{};  // restarted by stale replies: the quiet period's start
   Clock::time_point opened_at{};
-  int idle_with_lines_in_flight = 0;  // consecutive Idle reports while we wait for acks
-  std::size_t accepted_at_last_status = 0;
+  // The stall watch: Idle reports in a row, with lines unanswered and no answer between them.
+  std::optional<Clock::time_point> idle_since;
+  int idle_reports = 0;
+  std::size_t accepted_at_idle = 0;
+  std::vector<LineWait> line_waits;  // of the loaded span: how the controller answers each line
+  // Before the first line of a span: a status report, so that a controller left in feed hold
+  // (or with its door open) is reported instead of being sent lines it will not run.
+  bool checking_state = false;
+  Clock::time_point state_check_started{};
+  Clock::time_point last_doubt_poll{};
+  std::optional<int> rx_free_when_empty;  // the most free receive bytes the controller reported
 
   mutable std::mutex mutex;
   std::condition_variable done_cv;
@@ -134,12 +145,38 @@ struct Streamer::Impl {
       handshake_started = Clock::now();
       send_realtime_bytes(hello);
     } else {
-      load_pending();
+      check_state_then_load();
     }
+  }
+
+  void check_state_then_load() {
+    handshaking = false;
+    const std::string ask = protocol->realtime(RealtimeCommand::status);
+    if (ask.empty()) return load_pending();  // a drip feed reports nothing on its line
+    checking_state = true;
+    state_check_started = Clock::now();
+    send_realtime_bytes(ask);
+  }
+
+  // The report asked for before the first line: a held controller runs nothing we send (and
+  // answers a send-response line never), so say so now.
+  void on_state_checked(const ControllerStatus& status) {
+    checking_state = false;
+    const bool held = status.state == ControllerState::hold || status.state == ControllerState::hold_pending ||
+                      status.state == ControllerState::door;
+    if (!held) return load_pending();
+    finish(LinkError{LinkErrorCode::controller_held,
+                     fmt::format("the controller is in '{}' (a feed hold, or its door open) before the first line: "
+                                 "it would run nothing; resume or reset it at the machine, then start again",
+                                 status.state_text)});
   }
 
   void load_pending() {
     handshaking = false;
+    line_waits.clear();
+    line_waits.reserve(pending_span.lines.size());
+    for (const auto& line : pending_span.lines) line_waits.push_back(grbl_line_wait(line));
+    idle_since.reset();
     protocol->load(std::move(pending_span));
     loaded = true;
     pace_last = Clock::now();
@@ -211,6 +248,9 @@ struct Streamer::Impl {
           std::lock_guard lock(mutex);
           ++shared_progress.statuses_received;
         }
+        if (s->status.rx_bytes_free)
+          rx_free_when_empty = std::max(rx_free_when_empty.value_or(0), *s->status.rx_bytes_free);
+        if (checking_state && streaming) on_state_checked(s->status);
         check_lost_acknowledgement(s->status);
         if (callbacks.on_status) callbacks.on_status(s->status);
       } else if (const auto* r = std::get_if<LineRejected>(&event)) {
@@ -249,39 +289,67 @@ struct Streamer::Impl {
         finish(LinkError{LinkErrorCode::protocol_error, v->what});
       }
     }
-    if (handshaking && protocol->handshake_done()) load_pending();
+    if (handshaking && protocol->handshake_done()) check_state_then_load();
     if (streaming && loaded && protocol->finished()) finish(std::nullopt);
     publish_progress();
     pump();
   }
 
-  // A controller acknowledges a line when it takes it into its queue, long before it runs it.
-  // Idle in two reports in a row (asked after our last line went out, with no ack between)
-  // while we still wait for acks means an ok was lost or a line never arrived whole.
+  // A controller answers a line when it takes it into its queue, long before it runs it — but
+  // a line that syncs (a dwell, a jet change, program end) only once the motion before it is
+  // done, and a dwell after its time. So Idle while we wait for an answer is a fault only when
+  // the oldest unanswered line is an ordinary one, or a sync that has had its time: Idle in
+  // three reports in a row, with no answer between them, for longer than the margin plus the
+  // line's dwell. Then an `ok` was lost, a line never arrived whole, or the controller stopped
+  // reading its buffer.
   void check_lost_acknowledgement(const ControllerStatus& status) {
     const std::size_t accepted = protocol->lines_accepted();
     const std::size_t waiting = protocol->lines_sent() - accepted;
-    if (!streaming || !loaded || waiting == 0 || status.state != ControllerState::idle ||
-        accepted != accepted_at_last_status) {
-      idle_with_lines_in_flight = 0;
-      accepted_at_last_status = accepted;
+    if (!streaming || !loaded || waiting == 0 || status.state != ControllerState::idle) {
+      idle_since.reset();
       return;
     }
-    if (++idle_with_lines_in_flight < 3) return;
-    int rx_size = 0;
-    {
-      std::lock_guard lock(mutex);
-      rx_size = shared_progress.rx_buffer_bytes.value_or(0);
+    const auto now = Clock::now();
+    if (!idle_since || accepted != accepted_at_idle) {
+      idle_since = now;
+      idle_reports = 0;
+      accepted_at_idle = accepted;
     }
-    if (status.rx_bytes_free && rx_size > 0 && *status.rx_bytes_free < rx_size)
-      finish(LinkError{LinkErrorCode::timeout,
-                       fmt::format("the controller stalled: idle with {} byte(s) left in its receive buffer and {} "
-                                   "line(s) unacknowledged (from line {})",
-                                   rx_size - *status.rx_bytes_free, waiting, first_index + accepted + 1)});
-    else
-      finish(LinkError{LinkErrorCode::protocol_error,
-                       fmt::format("acknowledgement lost: the controller is idle with {} line(s) unacknowledged "
-                                   "(from line {})", waiting, first_index + accepted + 1)});
+    ++idle_reports;
+    const LineWait wait = accepted < line_waits.size() ? line_waits[accepted] : LineWait{};
+    const double allowed_s = settings.stall_margin_s + wait.dwell_s;
+    if (idle_reports < 3 || seconds_between(*idle_since, now) <= allowed_s) return;
+    finish(stall_error(status, waiting, first_index + accepted + 1, seconds_between(*idle_since, now)));
+  }
+
+  // Which fault it is, from the controller's own count of free receive bytes against ours of
+  // what it should still hold. Its free count when empty is the most it ever reported (grblHAL
+  // shows size − 1, classic Grbl the size), so `unread` is what sits in its buffer now.
+  //   unread ≥ our unanswered bytes: it took nothing of what waits — it stopped reading;
+  //   short by less than the oldest line: bytes were lost on the way, a line never ended;
+  //   short by a line or more: it took lines and their answers never came.
+  LinkError stall_error(const ControllerStatus& status, std::size_t waiting, std::size_t from_line, double idle_s) {
+    const auto ours = protocol->unanswered();
+    const std::string where = fmt::format("idle for {:.1f} s with {} line(s) unanswered (from line {})", idle_s,
+                                          waiting, from_line);
+    if (!status.rx_bytes_free || !ours || !rx_free_when_empty)
+      return LinkError{LinkErrorCode::timeout,
+                       fmt::format("the controller is {}: an answer was lost or it stopped reading", where)};
+    const long unread = std::max(0L, static_cast<long>(*rx_free_when_empty) - *status.rx_bytes_free);
+    const long missing = static_cast<long>(ours->bytes) - unread;
+    if (missing <= 0)
+      return LinkError{LinkErrorCode::timeout,
+                       fmt::format("the controller stalled: {}, all {} byte(s) of them unread in its receive buffer",
+                                   where, unread)};
+    if (missing < static_cast<long>(ours->oldest_line_bytes))
+      return LinkError{LinkErrorCode::protocol_error,
+                       fmt::format("bytes lost on the line: the controller is {}, {} byte(s) short of them in its "
+                                   "receive buffer (a line that never ended)",
+                                   where, missing)};
+    return LinkError{LinkErrorCode::protocol_error,
+                     fmt::format("acknowledgement lost: the controller is {}, and has taken {} byte(s) of them "
+                                 "from its receive buffer without answering",
+                                 where, missing)};
   }
 
   void send_realtime_bytes(std::string bytes) {
@@ -360,6 +428,25 @@ struct Streamer::Impl {
     shared_progress.seconds = seconds_between(started, Clock::now());
   }
 
+  // Without status polling, a quiet controller may be busy (a long move, a dwell, the drain
+  // before a sync) or dead: ask it before the silence timeout decides. A live one answers,
+  // and its report goes through the stall rule above.
+  void poll_when_in_doubt(Clock::time_point now) {
+    if (settings.status_period_s > 0 || !streaming || !loaded) return;
+    if (protocol->lines_sent() == protocol->lines_accepted()) return;
+    if (seconds_between(last_heard, now) < settings.silence_timeout_s / 4) return;
+    if (seconds_between(last_doubt_poll, now) < settings.silence_timeout_s / 4) return;
+    last_doubt_poll = now;
+    send_realtime_bytes(protocol->realtime(RealtimeCommand::status));
+  }
+
+  // A dwell is silent by design: the silence allowed grows by the dwell of the line waited on.
+  double silence_allowed_s() const {
+    const std::size_t accepted = protocol->lines_accepted();
+    const double dwell_s = accepted < line_waits.size() ? line_waits[accepted].dwell_s : 0;
+    return settings.silence_timeout_s + dwell_s;
+  }
+
   // Paced with a small backlog bound (XON/XOFF), the wire drains the bound quicker than the
   // usual tick: wake up twice per bound so the link stays busy (at least every 0.5 ms).
   double tick_period_s() const {
@@ -395,10 +482,17 @@ struct Streamer::Impl {
                                    transport ? transport->describe() : "link", settings.handshake_timeout_s)});
       return;
     }
+    if (checking_state && streaming && seconds_between(state_check_started, now) > settings.handshake_timeout_s) {
+      finish(LinkError{LinkErrorCode::timeout, fmt::format("{}: no status report within {} s before the first line",
+                                                           transport ? transport->describe() : "link",
+                                                           settings.handshake_timeout_s)});
+      return;
+    }
     if (settings.status_period_s > 0 && seconds_between(last_status_poll, now) >= settings.status_period_s) {
       last_status_poll = now;
       send_realtime_bytes(protocol->realtime(RealtimeCommand::status));
     }
+    poll_when_in_doubt(now);
     if (!protocol->flow_stopped()) flow_running_since = now;
     if (streaming && loaded && seconds_between(flow_running_since, now) > settings.silence_timeout_s) {
       finish(LinkError{LinkErrorCode::timeout, fmt::format("the controller has held the line (XOFF) for {} s",
@@ -406,7 +500,7 @@ struct Streamer::Impl {
       return;
     }
     const bool in_flight = protocol->lines_sent() > protocol->lines_accepted();
-    if (streaming && loaded && in_flight && seconds_between(last_heard, now) > settings.silence_timeout_s) {
+    if (streaming && loaded && in_flight && seconds_between(last_heard, now) > silence_allowed_s()) {
       finish(LinkError{LinkErrorCode::timeout,
                        fmt::format("nothing heard for {} s with {} line(s) in flight", settings.silence_timeout_s,
                                    protocol->lines_sent() - protocol->lines_accepted())});
@@ -467,19 +561,23 @@ std::optional<LinkOutcome> Streamer::wait(double timeout_s) {
 
 bool Streamer::can_reset() const { return !impl_->protocol->realtime(RealtimeCommand::reset).empty(); }
 
+std::optional<LinkError> Streamer::reset(double timeout_s) {
+  if (!can_reset()) return LinkError{LinkErrorCode::bad_request, "this protocol has no soft reset on its line"};
+  const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(timeout_s));
+  const int before = impl_->resets_seen.load();
+  request(RealtimeCommand::reset);
+  // The controller answers a reset with its banner; give it until the deadline.
+  while (impl_->resets_seen.load() == before && Clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  if (impl_->resets_seen.load() == before) return LinkError{LinkErrorCode::timeout, "no banner after the soft reset"};
+  return std::nullopt;
+}
+
 std::optional<LinkError> Streamer::recover(double timeout_s) {
   const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(timeout_s));
-  const std::string reset = impl_->protocol->realtime(RealtimeCommand::reset);
-  if (!reset.empty()) {
-    const int before = impl_->resets_seen.load();
-    request(RealtimeCommand::reset);
-    // The controller answers a reset with its banner; give it until the deadline.
-    while (impl_->resets_seen.load() == before && Clock::now() < deadline)
-      std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    if (impl_->resets_seen.load() == before)
-      return LinkError{LinkErrorCode::timeout, "no banner after the soft reset"};
-  }
-  if (reset.empty()) {
+  if (can_reset()) {
+    if (auto error = reset(timeout_s)) return error;
+  } else {
     // A drip feed is reset from the panel or the PLC, not over its line; it then releases the
     // line (SYN, then DC1). Streaming before that would run into the XOFF of the held buffer.
     while (impl_->flow_held.load() && Clock::now() < deadline) std::this_thread::sleep_for(std::chrono::milliseconds(10));

@@ -264,7 +264,10 @@ void SimRuntime::tick_plc(double now) {
                                          {"reset", pressed.reset}});
   }
   CncSnapshot snap;
-  snap.state = state_code(machine_.state());
+  // The PLC reads the CNC's state lamps: a grblHAL dwelling is Idle (mc_dwell plans nothing),
+  // as its `?` report says, so a mailbox host sees the same idle a line host does.
+  const MachineState state = machine_.state();
+  snap.state = state_code(state == MachineState::run && machine_.dwelling() ? MachineState::idle : state);
   snap.executed_blocks = machine_.executed_blocks();
   const AxisValues pos = machine_.position(now);
   for (int i = 0; i < kAxisCount; ++i) snap.position[i] = pos[static_cast<std::size_t>(i)];

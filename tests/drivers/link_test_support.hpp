@@ -2,8 +2,14 @@
 // Shared by the machine-link tests: programs with contour markers (as our posts write them),
 // the `lamina stream` CLI run as a user runs it, and the simulator's execution log read back
 // as program line indexes.
+#include <signal.h>
+#include <sys/wait.h>
+
+#include <chrono>
 #include <cstdio>
 #include <fstream>
+#include <thread>
+#include <utility>
 #include <string>
 #include <vector>
 
@@ -60,29 +66,68 @@ struct CliRun {
   std::string output;
 };
 
-inline CliRun run_lamina_stream(const std::string& args) {
-  CliRun r;
-  // Under `timeout`: a CLI that hangs fails its test in minutes, not at ctest's 25-minute limit.
-  const std::string command = fmt::format("timeout -k 5 180 '{}' stream {} --json 2>&1 < /dev/null", LAMINA_CLI, args);
-  FILE* pipe = ::popen(command.c_str(), "r");
-  char chunk[4096];
-  while (pipe && std::fgets(chunk, sizeof chunk, pipe)) r.output += chunk;
-  const int status = pipe ? ::pclose(pipe) : -1;
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  for (std::size_t start = 0; start < r.output.size();) {
-    auto end = r.output.find('\n', start);
-    if (end == std::string::npos) end = r.output.size();
-    const std::string line = r.output.substr(start, end - start);
+// The summary is the line of JSON among the log lines on the same pipe.
+inline nlohmann::json summary_of(const std::string& output) {
+  nlohmann::json summary;
+  for (std::size_t start = 0; start < output.size();) {
+    auto end = output.find('\n', start);
+    if (end == std::string::npos) end = output.size();
+    const std::string line = output.substr(start, end - start);
     if (!line.empty() && line.front() == '{') {
       try {
-        r.summary = nlohmann::json::parse(line);
+        summary = nlohmann::json::parse(line);
       } catch (const std::exception&) {
       }
     }
     start = end + 1;
   }
+  return summary;
+}
+
+inline CliRun finish_cli(std::FILE* pipe) {
+  CliRun r;
+  char chunk[4096];
+  while (pipe && std::fgets(chunk, sizeof chunk, pipe)) r.output += chunk;
+  const int status = pipe ? ::pclose(pipe) : -1;
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.summary = summary_of(r.output);
   return r;
 }
+
+inline CliRun run_lamina_stream(const std::string& args) {
+  // Under `timeout`: a CLI that hangs fails its test in minutes, not at ctest's 25-minute limit.
+  const std::string command = fmt::format("timeout -k 5 180 '{}' stream {} --json 2>&1 < /dev/null", LAMINA_CLI, args);
+  return finish_cli(::popen(command.c_str(), "r"));
+}
+
+// `lamina stream … --json` in the background, for what a test does while it cuts (a fault
+// through the control socket once the jet is on, the operator's Ctrl-C).
+class BackgroundStream {
+ public:
+  BackgroundStream(const TempDir& dir, const std::string& args) : pid_file_(dir.file("lamina-stream.pid")) {
+    const std::string command = fmt::format("sh -c 'echo $$ > \"{}\"; exec timeout -k 5 180 \"{}\" stream {} --json' "
+                                            "2>&1 < /dev/null",
+                                            pid_file_, LAMINA_CLI, args);
+    pipe_ = ::popen(command.c_str(), "r");
+  }
+  ~BackgroundStream() {
+    if (pipe_) finish();
+  }
+  // Signals reach the CLI through `timeout`, which passes them on.
+  bool signal(int sig) const {
+    int pid = 0;
+    for (int i = 0; i < 500 && pid <= 0; ++i) {
+      std::ifstream(pid_file_) >> pid;
+      if (pid <= 0) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    return pid > 0 && ::kill(pid, sig) == 0;
+  }
+  CliRun finish() { return finish_cli(std::exchange(pipe_, nullptr)); }
+
+ private:
+  std::string pid_file_;
+  std::FILE* pipe_ = nullptr;
+};
 
 // The completed blocks of the execution log, as texts in execution order.
 inline std::vector<std::string> executed_lines(const std::string& log_path, bool completed_only = true) {

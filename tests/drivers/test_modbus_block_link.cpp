@@ -76,6 +76,22 @@ TEST(ModbusBlockLink, AJetChangeWaitingForTheQueueToDrainIsNoTimeout) {
                           [&](const nlohmann::json& st) { return st["executed_blocks"] == program.size(); }, 20));
 }
 
+// A dwelling CNC stands Idle on its state lamps (grblHAL plans nothing for G4) and takes the
+// block behind the dwell only when it ends: the dwell's P is no lost block either.
+TEST(ModbusBlockLink, TheBlockBehindADwellLongerThanTheAckTimeoutIsNoTimeout) {
+  SimCell cell({"--time-scale", "1"});
+  auto settings = settings_for(cell.sim.modbus_port());
+  settings.ack_timeout_s = 0.5;
+  ModbusBlockLink link(settings);
+  const std::vector<std::string> program{"G21G90G94", "G1X5F600", "M3", "G4P1.5", "G1X6", "M5"};
+  link.start(LineSpan{program, 0}, {});
+  const auto outcome = link.wait(30);
+  ASSERT_TRUE(outcome);
+  ASSERT_TRUE(outcome->completed) << (outcome->error ? outcome->error->message : "");
+  ASSERT_TRUE(wait_status(cell.sim.control_port(),
+                          [&](const nlohmann::json& st) { return st["executed_blocks"] == program.size(); }, 20));
+}
+
 TEST(ModbusBlockLink, FeedHoldAndResumeGoThroughThePlcCoils) {
   SimCell cell({"--planner-blocks", "5"});  // the queue fills: the job is still streaming when stopped
   ModbusBlockLink link(settings_for(cell.sim.modbus_port()));

@@ -34,7 +34,9 @@ struct PtySim {
   SimProcess sim;
   explicit PtySim(std::vector<std::string> extra = {})
       : sim([&] {
-          std::vector<std::string> args{"--link", link, "--control", "127.0.0.1:0"};
+          // A board that greets every open (a USB bridge that resets it): the banner is what
+          // these tests read first. grblHAL on native USB stays quiet (lamina-sim's default).
+          std::vector<std::string> args{"--link", link, "--control", "127.0.0.1:0", "--on-open", "banner"};
           args.insert(args.end(), extra.begin(), extra.end());
           return args;
         }()) {}
@@ -67,7 +69,7 @@ TEST(Transports, PtyLinkReadsTheBannerAndAnswersBuildInfoOverARawLine) {
 }
 
 TEST(Transports, TcpLinkReadsTheBannerAndAnswersBuildInfo) {
-  SimProcess sim({"--tcp", "127.0.0.1:0"});
+  SimProcess sim({"--tcp", "127.0.0.1:0", "--on-open", "banner"});
   boost::asio::io_context io;
   auto t = open_tcp(io, "127.0.0.1", sim.tcp_port(), 2.0);
   ASSERT_TRUE(t) << t.error().message;
@@ -177,7 +179,7 @@ TEST(Transports, UnpluggingThePtyCompletesThePendingReadWithAnError) {
 }
 
 TEST(Transports, UnpluggingTheTcpLinkCompletesThePendingReadWithAnError) {
-  SimProcess sim({"--tcp", "127.0.0.1:0", "--unplug-at", "0.5"});
+  SimProcess sim({"--tcp", "127.0.0.1:0", "--on-open", "banner", "--unplug-at", "0.5"});
   boost::asio::io_context io;
   auto t = open_tcp(io, "127.0.0.1", sim.tcp_port(), 2.0);
   ASSERT_TRUE(t) << t.error().message;

@@ -26,6 +26,7 @@ struct MachineLinkConfig {
   int baud = 115200;
   std::size_t rx_buffer = 0;               // 0: as the controller reports
   double status_hz = 5;
+  double stall_margin_s = 2;               // Idle with lines unanswered this long (+ a dwell's P): a stall
 };
 
 struct CellConfig {

@@ -81,6 +81,7 @@ class CutJob {
   // Blocks the CNC has finished, from the link's status or the PLC's (nullopt: neither says).
   std::optional<std::uint64_t> executed_blocks(bool fresh);
   void stop_safely(LinkError why);
+  std::optional<LinkError> jet_off_without_plc(bool axes_still);
   std::function<void(const CellFaultReport&)> fault_handler();
   void set_state(CutState state);
 

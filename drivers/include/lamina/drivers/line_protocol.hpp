@@ -95,6 +95,16 @@ class LineProtocol {
   // fit the controller's tolerance (a Fanuc takes about 10 characters after DC3).
   virtual std::size_t max_backlog_bytes() const { return 0; }
 
+  // What sits in the controller's receive buffer by our count: the bytes of every line sent and
+  // not yet answered, and of the oldest of them (nullopt: the protocol does not count bytes).
+  // Set against the controller's own free count, it tells a controller that stopped reading
+  // from one whose answer was lost.
+  struct Unanswered {
+    std::size_t bytes = 0;
+    std::size_t oldest_line_bytes = 0;
+  };
+  virtual std::optional<Unanswered> unanswered() const { return std::nullopt; }
+
   virtual std::size_t lines_sent() const = 0;      // of the loaded span
   virtual std::size_t lines_accepted() const = 0;  // acknowledged (or, for XON/XOFF, written)
   virtual bool finished() const = 0;               // every loaded line accepted

@@ -18,6 +18,7 @@ enum class LinkErrorCode : int {
   modbus_error = 10,      // Modbus transport or exception response
   cancelled = 11,         // the operator or the caller stopped it
   bad_request = 12,       // a malformed argument (address, settings)
+  controller_held = 13,   // in feed hold or with its door open before our first line: it would run nothing
 };
 
 struct LinkError {

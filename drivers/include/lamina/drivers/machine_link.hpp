@@ -55,6 +55,13 @@ class MachineLink {
   virtual std::optional<LinkError> recover(double timeout_s) = 0;
   // Whether recover() can reset the controller at all (a drip feed's line cannot: the PLC can).
   virtual bool can_reset() const = 0;
+  // The soft reset alone (grbl: 0x18), waiting for the controller to say it reset; no unlock,
+  // so an alarm stays for the operator to see. Motion, queue and the jet's M-code are gone.
+  // What a stop does where no PLC can turn the jet off. Blocking.
+  virtual std::optional<LinkError> reset(double timeout_s) {
+    (void)timeout_s;
+    return LinkError{LinkErrorCode::bad_request, "this link has no reset of its own"};
+  }
   // Blocks until the last start() finished; nullopt on timeout.
   virtual std::optional<LinkOutcome> wait(double timeout_s) = 0;
 };

@@ -15,6 +15,11 @@ struct StreamerSettings {
   double status_period_s = 0.2;    // 5 Hz '?' (0: no polling)
   double handshake_timeout_s = 5;  // banner / [OPT:] after connecting
   double silence_timeout_s = 10;   // lines in flight and nothing heard for this long: timeout
+  // The controller reports Idle while a line waits for its answer: a lost `ok`, or a line that
+  // never arrived whole — unless the line is one the controller answers only when done (a
+  // dwell, a jet change, program end: line_wait.hpp). The stop comes after this margin (plus
+  // the dwell's own time) and at least three such reports in a row.
+  double stall_margin_s = 2;
   // Pace program bytes to the line rate (bytes/s, 0 = unpaced): what sits in a kernel buffer
   // cannot be held back by a DC3, so an XON/XOFF sender keeps that backlog small.
   double pace_bytes_per_s = 0;
@@ -41,6 +46,7 @@ class Streamer final : public MachineLink {
   LinkProgress progress() const override;
   std::optional<LinkError> recover(double timeout_s) override;
   bool can_reset() const override;
+  std::optional<LinkError> reset(double timeout_s) override;
   std::optional<LinkOutcome> wait(double timeout_s) override;
 
   RealtimeLatency realtime_latency() const;
