@@ -59,6 +59,16 @@ TEST(ModbusBlockLink, ASecondJobContinuesTheSequenceNumbers) {
   ASSERT_TRUE(wait_status(cell.sim.control_port(), [](const nlohmann::json& st) { return st["executed_blocks"] == 20; }, 10));
 }
 
+// The job completes, and the CNC executes every block of it.
+void expect_completes(ModbusBlockLink& link, const SimCell& cell, const std::vector<std::string>& program) {
+  link.start(LineSpan{program, 0}, {});
+  const auto outcome = link.wait(30);
+  ASSERT_TRUE(outcome);
+  ASSERT_TRUE(outcome->completed) << (outcome->error ? outcome->error->message : "");
+  ASSERT_TRUE(wait_status(cell.sim.control_port(),
+                          [&](const nlohmann::json& st) { return st["executed_blocks"] == program.size(); }, 20));
+}
+
 // The CNC takes a jet M-code only once its queue has drained (planner sync): a mailbox block
 // may wait for seconds of cutting. That is a busy CNC, not a lost block: no timeout.
 TEST(ModbusBlockLink, AJetChangeWaitingForTheQueueToDrainIsNoTimeout) {
@@ -68,12 +78,7 @@ TEST(ModbusBlockLink, AJetChangeWaitingForTheQueueToDrainIsNoTimeout) {
   ModbusBlockLink link(settings);
   auto program = program_of(20, 600);  // 18 moves of 1-6 mm at 10 mm/s: ~3 s queued ahead of M5
   program.insert(program.end(), {"M5", "G0X0Y0"});
-  link.start(LineSpan{program, 0}, {});
-  const auto outcome = link.wait(30);
-  ASSERT_TRUE(outcome);
-  ASSERT_TRUE(outcome->completed) << (outcome->error ? outcome->error->message : "");
-  ASSERT_TRUE(wait_status(cell.sim.control_port(),
-                          [&](const nlohmann::json& st) { return st["executed_blocks"] == program.size(); }, 20));
+  expect_completes(link, cell, program);
 }
 
 // A dwelling CNC stands Idle on its state lamps (grblHAL plans nothing for G4) and takes the
@@ -84,12 +89,7 @@ TEST(ModbusBlockLink, TheBlockBehindADwellLongerThanTheAckTimeoutIsNoTimeout) {
   settings.ack_timeout_s = 0.5;
   ModbusBlockLink link(settings);
   const std::vector<std::string> program{"G21G90G94", "G1X5F600", "M3", "G4P1.5", "G1X6", "M5"};
-  link.start(LineSpan{program, 0}, {});
-  const auto outcome = link.wait(30);
-  ASSERT_TRUE(outcome);
-  ASSERT_TRUE(outcome->completed) << (outcome->error ? outcome->error->message : "");
-  ASSERT_TRUE(wait_status(cell.sim.control_port(),
-                          [&](const nlohmann::json& st) { return st["executed_blocks"] == program.size(); }, 20));
+  expect_completes(link, cell, program);
 }
 
 TEST(ModbusBlockLink, FeedHoldAndResumeGoThroughThePlcCoils) {
