@@ -1,6 +1,6 @@
 #include "lamina/drivers/streamer.hpp"
 
-#include "lamina/drivers/line_wait.hpp"
+#include "stall_watch.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -68,17 +68,12 @@ struct Streamer::Impl {
   bool awaiting_banner = false;
   Clock::time_point connected_at{};  // restarted by stale replies: the quiet period's start
   Clock::time_point opened_at{};
-  // The stall watch: Idle reports in a row, with lines unanswered and no answer between them.
-  std::optional<Clock::time_point> idle_since;
-  int idle_reports = 0;
-  std::size_t accepted_at_idle = 0;
-  std::vector<LineWait> line_waits;  // of the loaded span: how the controller answers each line
+  detail::StallWatch stall_watch{settings.stall_margin_s};
   // Before the first line of a span: a status report, so that a controller left in feed hold
   // (or with its door open) is reported instead of being sent lines it will not run.
   bool checking_state = false;
   Clock::time_point state_check_started{};
   Clock::time_point last_doubt_poll{};
-  std::optional<int> rx_free_when_empty;  // the most free receive bytes the controller reported
 
   mutable std::mutex mutex;
   std::condition_variable done_cv;
@@ -173,10 +168,7 @@ struct Streamer::Impl {
 
   void load_pending() {
     handshaking = false;
-    line_waits.clear();
-    line_waits.reserve(pending_span.lines.size());
-    for (const auto& line : pending_span.lines) line_waits.push_back(grbl_line_wait(line));
-    idle_since.reset();
+    stall_watch.load(pending_span.lines, pending_span.first_index);
     protocol->load(std::move(pending_span));
     loaded = true;
     pace_last = Clock::now();
@@ -248,8 +240,6 @@ struct Streamer::Impl {
           std::lock_guard lock(mutex);
           ++shared_progress.statuses_received;
         }
-        if (s->status.rx_bytes_free)
-          rx_free_when_empty = std::max(rx_free_when_empty.value_or(0), *s->status.rx_bytes_free);
         if (checking_state && streaming) on_state_checked(s->status);
         check_lost_acknowledgement(s->status);
         if (callbacks.on_status) callbacks.on_status(s->status);
@@ -295,61 +285,13 @@ struct Streamer::Impl {
     pump();
   }
 
-  // A controller answers a line when it takes it into its queue, long before it runs it — but
-  // a line that syncs (a dwell, a jet change, program end) only once the motion before it is
-  // done, and a dwell after its time. So Idle while we wait for an answer is a fault only when
-  // the oldest unanswered line is an ordinary one, or a sync that has had its time: Idle in
-  // three reports in a row, with no answer between them, for longer than the margin plus the
-  // line's dwell. Then an `ok` was lost, a line never arrived whole, or the controller stopped
-  // reading its buffer.
+  // Idle with lines unanswered: a lost `ok`, a line that never arrived whole, or a controller
+  // that stopped reading — unless the line waited on is a dwell or a sync (stall_watch.hpp).
   void check_lost_acknowledgement(const ControllerStatus& status) {
-    const std::size_t accepted = protocol->lines_accepted();
-    const std::size_t waiting = protocol->lines_sent() - accepted;
-    if (!streaming || !loaded || waiting == 0 || status.state != ControllerState::idle) {
-      idle_since.reset();
-      return;
-    }
-    const auto now = Clock::now();
-    if (!idle_since || accepted != accepted_at_idle) {
-      idle_since = now;
-      idle_reports = 0;
-      accepted_at_idle = accepted;
-    }
-    ++idle_reports;
-    const LineWait wait = accepted < line_waits.size() ? line_waits[accepted] : LineWait{};
-    const double allowed_s = settings.stall_margin_s + wait.dwell_s;
-    if (idle_reports < 3 || seconds_between(*idle_since, now) <= allowed_s) return;
-    finish(stall_error(status, waiting, first_index + accepted + 1, seconds_between(*idle_since, now)));
-  }
-
-  // Which fault it is, from the controller's own count of free receive bytes against ours of
-  // what it should still hold. Its free count when empty is the most it ever reported (grblHAL
-  // shows size − 1, classic Grbl the size), so `unread` is what sits in its buffer now.
-  //   unread ≥ our unanswered bytes: it took nothing of what waits — it stopped reading;
-  //   short by less than the oldest line: bytes were lost on the way, a line never ended;
-  //   short by a line or more: it took lines and their answers never came.
-  LinkError stall_error(const ControllerStatus& status, std::size_t waiting, std::size_t from_line, double idle_s) {
-    const auto ours = protocol->unanswered();
-    const std::string where = fmt::format("idle for {:.1f} s with {} line(s) unanswered (from line {})", idle_s,
-                                          waiting, from_line);
-    if (!status.rx_bytes_free || !ours || !rx_free_when_empty)
-      return LinkError{LinkErrorCode::timeout,
-                       fmt::format("the controller is {}: an answer was lost or it stopped reading", where)};
-    const long unread = std::max(0L, static_cast<long>(*rx_free_when_empty) - *status.rx_bytes_free);
-    const long missing = static_cast<long>(ours->bytes) - unread;
-    if (missing <= 0)
-      return LinkError{LinkErrorCode::timeout,
-                       fmt::format("the controller stalled: {}, all {} byte(s) of them unread in its receive buffer",
-                                   where, unread)};
-    if (missing < static_cast<long>(ours->oldest_line_bytes))
-      return LinkError{LinkErrorCode::protocol_error,
-                       fmt::format("bytes lost on the line: the controller is {}, {} byte(s) short of them in its "
-                                   "receive buffer (a line that never ended)",
-                                   where, missing)};
-    return LinkError{LinkErrorCode::protocol_error,
-                     fmt::format("acknowledgement lost: the controller is {}, and has taken {} byte(s) of them "
-                                 "from its receive buffer without answering",
-                                 where, missing)};
+    if (!streaming || !loaded) return;
+    const detail::LinkCounts counts{protocol->lines_sent(), protocol->lines_accepted(), protocol->unanswered()};
+    const double now_s = std::chrono::duration<double>(Clock::now().time_since_epoch()).count();
+    if (auto error = stall_watch.on_status(status, now_s, counts)) finish(std::move(*error));
   }
 
   void send_realtime_bytes(std::string bytes) {
@@ -442,9 +384,7 @@ struct Streamer::Impl {
 
   // A dwell is silent by design: the silence allowed grows by the dwell of the line waited on.
   double silence_allowed_s() const {
-    const std::size_t accepted = protocol->lines_accepted();
-    const double dwell_s = accepted < line_waits.size() ? line_waits[accepted].dwell_s : 0;
-    return settings.silence_timeout_s + dwell_s;
+    return stall_watch.silence_allowed_s(settings.silence_timeout_s, protocol->lines_accepted());
   }
 
   // Paced with a small backlog bound (XON/XOFF), the wire drains the bound quicker than the
