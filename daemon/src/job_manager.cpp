@@ -244,9 +244,13 @@ std::expected<JobRecord, RpcError> JobManager::cancel(const std::string& id) {
         machine_job_.clear();
         cut_.reset();
         // The stop left the pump running for a resume; nobody will resume now. Blocking Modbus
-        // work stays off the io thread: the cutter slot is free (nothing is cutting).
-        if (machine_.cell() && !cutter_.joinable())
+        // work stays off the io thread. The cutter slot is free: nothing is cutting, and a
+        // cutter that ended on the fault has left finish_cut (cutting_ is false) — join it, or
+        // the pump and abrasive stayed on (a joinable cutter used to skip this).
+        if (machine_.cell()) {
+          if (cutter_.joinable()) cutter_.join();
           cutter_ = std::thread([cell = machine_.cell()] { (void)cell->finish_cut(); });
+        }
         assign_machine();
       }
       return *job;

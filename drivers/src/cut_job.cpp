@@ -75,7 +75,18 @@ std::function<void(const CellFaultReport&)> CutJob::fault_handler() {
   };
 }
 
+// A line the link must not send is found before the pump starts or a byte goes out.
+bool CutJob::refuse_unsendable() {
+  auto bad = link_.check_lines(program_, 0);
+  if (!bad) return false;
+  std::lock_guard lock(mutex_);
+  report_.state = CutState::failed;
+  report_.reason = std::move(bad);
+  return true;
+}
+
 CutReport CutJob::run() {
+  if (refuse_unsendable()) return report();
   if (cell_) {
     set_state(CutState::preparing);
     cell_->on_fault(fault_handler());
@@ -90,6 +101,7 @@ CutReport CutJob::run() {
 }
 
 CutReport CutJob::resume_from(std::size_t first_unfinished_line) {
+  if (refuse_unsendable()) return report();
   if (cell_) cell_->on_fault(fault_handler());
   {
     std::lock_guard lock(mutex_);

@@ -10,9 +10,26 @@
 
 #include "grbl_counting.hpp"
 #include "grbl_reply.hpp"
+#include "realtime_scan.hpp"
 
 namespace lamina::drivers::detail {
 namespace {
+
+// grblHAL's real-time commands (its stream drivers pick them off the wire, ahead of the line
+// buffer): the legacy ? ! ~ and ctrl-X, and every top-bit byte — overrides 0x90–0x9D, spindle
+// stop 0x9E, coolant toggles 0xA0/0xA1, door 0x84, jog cancel 0x85, and others to come. A
+// UTF-8 character in a comment (°, Ø, ×) is such bytes too.
+const char* grbl_realtime_meaning(unsigned char c) {
+  switch (c) {
+    case '?': return "the status request";
+    case '!': return "a feed hold";
+    case '~': return "a cycle start";
+    case 0x18: return "a soft reset";
+    default: break;
+  }
+  if (c >= 0x80) return "one of grblHAL's extended real-time commands (overrides, door, jog cancel…)";
+  return nullptr;
+}
 
 // Classic Grbl (AVR) has a 128-byte receive buffer and no `[OPT:]` rx field.
 constexpr std::size_t kClassicGrblRxBytes = 128;
@@ -50,6 +67,12 @@ class CountingProtocol final : public LineProtocol {
     return std::string(kBuildInfoRequest);
   }
   bool handshake_done() const override { return handshake_done_; }
+
+  std::optional<LinkError> check_lines(const std::vector<std::string>& lines, std::size_t first_index) const override {
+    for (std::size_t i = 0; i < lines.size(); ++i)
+      if (auto bad = refuse_realtime_line(first_index + i, lines[i], grbl_realtime_meaning, "grbl")) return bad;
+    return std::nullopt;
+  }
 
   void load(LineSpan span) override {
     // Lines of an earlier span may still await their answers (the controller has them).

@@ -25,6 +25,13 @@ using Clock = std::chrono::steady_clock;
 namespace {
 constexpr auto kPollInterval = std::chrono::milliseconds(2);  // ack / room polling while streaming
 Clock::duration seconds(double s) { return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s)); }
+// Every block must fit the mailbox and be one line (check_mailbox_block).
+std::optional<LinkError> check_program_lines(const std::vector<std::string>& lines, std::size_t first_index) {
+  for (std::size_t i = 0; i < lines.size(); ++i)
+    if (auto bad = check_mailbox_block(first_index + i, lines[i])) return bad;
+  return std::nullopt;
+}
+
 }  // namespace
 
 struct ModbusBlockLink::Impl {
@@ -191,8 +198,7 @@ struct ModbusBlockLink::Impl {
   }
 
   void run_job(LineSpan span) {
-    for (std::size_t i = 0; i < span.lines.size(); ++i)
-      if (auto bad = check_mailbox_block(span.first_index + i, span.lines[i])) return finish(bad, span.first_index);
+    if (auto bad = check_program_lines(span.lines, span.first_index)) return finish(bad, span.first_index);
     if (auto r = begin_job(); !r) return finish(r.error(), span.first_index);
 
     Clock::time_point dwell_ends{};  // when the last dwell the CNC took is over
@@ -249,6 +255,11 @@ struct ModbusBlockLink::Impl {
     finish(std::nullopt, span.first_index);
   }
 };
+
+std::optional<LinkError> ModbusBlockLink::check_lines(const std::vector<std::string>& lines,
+                                                      std::size_t first_index) const {
+  return check_program_lines(lines, first_index);
+}
 
 ModbusBlockLink::ModbusBlockLink(ModbusBlockSettings settings)
     : impl_(std::make_unique<Impl>(std::move(settings))) {}

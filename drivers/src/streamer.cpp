@@ -113,6 +113,7 @@ struct Streamer::Impl {
     started = last_heard = flow_running_since = Clock::now();
     streaming = true;
     loaded = false;
+    if (auto bad = protocol->check_lines(span.lines, span.first_index)) return finish(std::move(*bad));
     if (!transport) {
       auto opened = open(io);
       if (!opened) return finish(opened.error());
@@ -462,6 +463,10 @@ Streamer::Streamer(TransportFactory open, std::unique_ptr<LineProtocol> protocol
     : impl_(std::make_unique<Impl>(std::move(open), std::move(protocol), settings)) {}
 
 Streamer::~Streamer() = default;
+
+std::optional<LinkError> Streamer::check_lines(const std::vector<std::string>& lines, std::size_t first_index) const {
+  return impl_->protocol->check_lines(lines, first_index);
+}
 
 void Streamer::start(LineSpan span, LinkCallbacks callbacks) {
   {

@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 
 #include "lamina/drivers/line_protocol.hpp"
+#include "realtime_scan.hpp"
 
 namespace lamina::drivers {
 namespace {
@@ -19,6 +20,19 @@ constexpr char kDc1 = 0x11;  // XON: resume
 constexpr char kDc3 = 0x13;  // XOFF: stop sending
 constexpr char kNak = 0x15;  // after DC3: alarm
 constexpr char kSyn = 0x16;  // after DC3: reset
+
+// ISO 840 / Fanuc tape codes: DC1–DC4 switch the reader and punch; `%` ends the program (the
+// rest of the tape is ignored) — allowed only as the program's own first and last lines.
+const char* xonxoff_realtime_meaning(unsigned char c) {
+  switch (c) {
+    case 0x11: return "DC1 (reader on)";
+    case 0x12: return "DC2 (punch on)";
+    case 0x13: return "DC3 (reader off)";
+    case 0x14: return "DC4 (punch off)";
+    case '%': return "the end of the program";
+    default: return nullptr;
+  }
+}
 
 class XonXoffProtocol final : public LineProtocol {
  public:
@@ -29,6 +43,17 @@ class XonXoffProtocol final : public LineProtocol {
   std::string name() const override { return "xonxoff"; }
   std::string handshake() override { return {}; }
   bool handshake_done() const override { return true; }
+
+  std::optional<LinkError> check_lines(const std::vector<std::string>& lines, std::size_t first_index) const override {
+    for (std::size_t i = 0; i < lines.size(); ++i) {
+      const std::string_view line = strip_cr(lines[i]);
+      const bool frame = line == "%" && ((i == 0 && first_index == 0) || i + 1 == lines.size());
+      if (frame) continue;
+      if (auto bad = detail::refuse_realtime_line(first_index + i, line, xonxoff_realtime_meaning, "drip-fed"))
+        return bad;
+    }
+    return std::nullopt;
+  }
 
   // Lines end in LF (ISO code EOB on a Fanuc). The frame is added only when the program does
   // not open with its own `%`; a program that does is sent exactly as loaded.

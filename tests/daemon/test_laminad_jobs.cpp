@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "daemon_fixture.hpp"
+#include "modbus_test_client.hpp"
 
 namespace lamina::daemon::testing {
 namespace {
@@ -146,6 +147,34 @@ TEST(LaminadJobs, AbortStopsSafelyAndJobResumeRestartsAtTheContour) {
     if (lines[k].rfind("(CONTOUR ", 0) == 0) contour_of_stop = k;
   EXPECT_EQ(restart, contour_of_stop) << "restart at the start of the contour being cut, not earlier";
   EXPECT_EQ(log.back().line, lines.back());
+}
+
+// A fault stops the cut and leaves the pump pressurised for a resume; the operator cancels
+// instead: nobody will resume, so pump and abrasive go off (issue 16, item 3: a cutter thread
+// that had ended on the fault was still joinable, and the cancel skipped the cell's shutdown).
+TEST(LaminadJobs, CancelAfterAFaultTurnsPumpAndAbrasiveOff) {
+  Cell cell({}, 40);
+  Laminad daemon(cell.config(), cell.dir.file(""));
+  RpcClient c = connect(cell.socket());
+  Json job = call_ok(c, "job.submit", {{"model", kModel}, {"settings", {{"stock", "5"}}}});
+  const std::string id = job["id"];
+  ASSERT_EQ(wait_state(c, id, "waiting_sheet", 120)["state"], "waiting_sheet") << daemon.log();
+  call_ok(c, "job.confirm_sheet", {{"job", id}, {"sheet", 1}});
+  ASSERT_TRUE(sim::testing::wait_status(cell.sim.control_port(), [](const Json& s) { return s["executed_blocks"] > 100; }, 60));
+  ASSERT_EQ(sim::testing::control(cell.sim.control_port(), "pressure drop"), "ok");
+  job = wait_state(c, id, "paused", 30);
+  ASSERT_EQ(job["state"], "paused") << job.dump(2);
+  drivers::testing::PlcProbe plc(cell.sim.modbus_port());
+  ASSERT_EQ(plc.coil(drivers::testing::map::kCoilPump), 1) << "the stop keeps the pump for a resume";
+  call_ok(c, "job.cancel", {{"job", id}});
+  EXPECT_EQ(wait_state(c, id, "cancelled", 10)["state"], "cancelled");
+  const auto t0 = std::chrono::steady_clock::now();
+  while ((plc.coil(drivers::testing::map::kCoilPump) != 0 || plc.coil(drivers::testing::map::kCoilAbrasive) != 0) &&
+         seconds_since(t0) < 10)
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  EXPECT_EQ(plc.coil(drivers::testing::map::kCoilPump), 0) << daemon.log();
+  EXPECT_EQ(plc.coil(drivers::testing::map::kCoilAbrasive), 0);
+  EXPECT_EQ(plc.coil(drivers::testing::map::kCoilJet), 0);
 }
 
 TEST(LaminadJobs, CancelWhilePlanningStopsThePlanner) {

@@ -78,6 +78,7 @@ class CutJob {
 
  private:
   CutReport stream_from(std::size_t from, std::vector<std::string> preamble);
+  bool refuse_unsendable();
   // Blocks the CNC has finished, from the link's status or the PLC's (nullopt: neither says).
   std::optional<std::uint64_t> executed_blocks(bool fresh);
   void stop_safely(LinkError why);

@@ -8,6 +8,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <limits>
 #include <string>
 #include <string_view>
@@ -15,6 +16,7 @@
 #include <vector>
 
 #include "lamina/drivers/controller_status.hpp"
+#include "lamina/drivers/link_error.hpp"
 
 namespace lamina::drivers {
 
@@ -66,6 +68,12 @@ class LineProtocol {
   virtual std::string handshake() = 0;
   virtual bool handshake_done() const = 0;
 
+  // Before anything is sent: a line this protocol must not send — one that holds a byte the
+  // controller takes as a real-time command wherever it stands, comments included (grbl: `?`
+  // `!` `~` 0x18 and 0x80–0xFF; XON/XOFF: DC1–DC4 and a `%` inside the program). bad_request
+  // naming the line (1-based), the column and what the byte would do.
+  // `first_index` numbers the lines as in LineSpan. Const and stateless: callable from any thread.
+  virtual std::optional<LinkError> check_lines(const std::vector<std::string>& lines, std::size_t first_index) const = 0;
   // Load lines to stream. Replaces whatever was loaded; nothing may be in flight.
   virtual void load(LineSpan span) = 0;
   // Bytes that may go on the wire now (window, XOFF, one-in-flight…), marked as sent, at most

@@ -43,6 +43,9 @@ struct LinkCallbacks {
 class MachineLink {
  public:
   virtual ~MachineLink() = default;
+  // Before anything is sent: a line this link must not carry (a real-time byte of its
+  // protocol, a block too long for the mailbox), as bad_request naming it. start() checks too.
+  virtual std::optional<LinkError> check_lines(const std::vector<std::string>& lines, std::size_t first_index) const = 0;
   // Connect (if needed), run the protocol's handshake and stream `span`. Returns at once.
   virtual void start(LineSpan span, LinkCallbacks callbacks) = 0;
   // Real-time command, ahead of the queue (feed hold, resume, reset, status).

@@ -22,6 +22,7 @@ class ModbusBlockLink final : public MachineLink {
   explicit ModbusBlockLink(ModbusBlockSettings settings);
   ~ModbusBlockLink() override;
 
+  std::optional<LinkError> check_lines(const std::vector<std::string>& lines, std::size_t first_index) const override;
   void start(LineSpan span, LinkCallbacks callbacks) override;
   void request(RealtimeCommand command) override;
   void stop(LinkError why) override;

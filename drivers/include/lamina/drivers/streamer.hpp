@@ -40,6 +40,7 @@ class Streamer final : public MachineLink {
   Streamer(TransportFactory open, std::unique_ptr<LineProtocol> protocol, StreamerSettings settings);
   ~Streamer() override;
 
+  std::optional<LinkError> check_lines(const std::vector<std::string>& lines, std::size_t first_index) const override;
   void start(LineSpan span, LinkCallbacks callbacks) override;
   void request(RealtimeCommand command) override;
   void stop(LinkError why) override;
