@@ -7,6 +7,7 @@
 #include <chrono>
 #include <condition_variable>
 #include <deque>
+#include <future>
 #include <mutex>
 #include <thread>
 #include <utility>
@@ -65,7 +66,7 @@ struct Streamer::Impl {
   bool error_lock_pending = false;
   std::atomic<int> resets_seen{0};    // banners while not streaming (recover() waits for one)
   std::atomic<bool> flow_held{false};  // the protocol's flow_stopped(), readable off the io thread
-  bool awaiting_banner = false;
+  std::atomic<bool> awaiting_banner{false};  // read by reset() off the io thread
   Clock::time_point connected_at{};  // restarted by stale replies: the quiet period's start
   Clock::time_point opened_at{};
   detail::StallWatch stall_watch{settings.stall_margin_s};
@@ -115,16 +116,7 @@ struct Streamer::Impl {
     loaded = false;
     if (auto bad = protocol->check_lines(span.lines, span.first_index)) return finish(std::move(*bad));
     if (!transport) {
-      auto opened = open(io);
-      if (!opened) return finish(opened.error());
-      transport = std::move(*opened);
-      spdlog::info("link: connected {}", transport->describe());
-      // Many controllers greet a new connection with their banner (a DTR reset, a telnet
-      // greeting). Anything sent before it may be lost or answered out of turn, so the
-      // handshake waits for the banner, or for a short quiet period when none comes.
-      awaiting_banner = true;
-      connected_at = opened_at = Clock::now();
-      read_more();
+      if (auto error = connect()) return finish(std::move(*error));
     } else if (awaiting_banner) {
       opened_at = Clock::now();  // a new job gives a chattering controller a new chance
     }
@@ -132,6 +124,21 @@ struct Streamer::Impl {
     schedule_tick();
     if (awaiting_banner) return;  // the handshake follows the banner (or the quiet period)
     send_handshake_or_load();
+  }
+
+  // Opens the transport. Many controllers greet a new connection with their banner (a DTR
+  // reset, a telnet greeting); anything sent before it may be lost or answered out of turn, so
+  // the handshake waits for the banner, or for a short quiet period when none comes.
+  std::optional<LinkError> connect() {
+    auto opened = open(io);
+    if (!opened) return opened.error();
+    transport = std::move(*opened);
+    spdlog::info("link: connected {}", transport->describe());
+    awaiting_banner = true;
+    connected_at = opened_at = Clock::now();
+    read_more();
+    schedule_tick();  // the ticks stopped with the lost transport; status polling resumes
+    return std::nullopt;
   }
 
   void send_handshake_or_load() {
@@ -509,6 +516,17 @@ bool Streamer::can_reset() const { return !impl_->protocol->realtime(RealtimeCom
 std::optional<LinkError> Streamer::reset(double timeout_s) {
   if (!can_reset()) return LinkError{LinkErrorCode::bad_request, "this protocol has no soft reset on its line"};
   const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(timeout_s));
+  // A link lost to an unplug is opened again first (the port may be back): a reset written to
+  // no port reaches nobody, and a resume after a replug always failed on it.
+  std::promise<std::optional<LinkError>> opened;
+  auto reopened = opened.get_future();
+  asio::post(impl_->io, [impl = impl_.get(), &opened] {
+    opened.set_value(impl->transport ? std::nullopt : impl->connect());
+  });
+  if (auto error = reopened.get()) return error;
+  // A board that greets the new connection does so first; our reset's banner must not be
+  // mistaken for that one (or that one for ours).
+  while (impl_->awaiting_banner.load() && Clock::now() < deadline) std::this_thread::sleep_for(std::chrono::milliseconds(10));
   const int before = impl_->resets_seen.load();
   request(RealtimeCommand::reset);
   // The controller answers a reset with its banner; give it until the deadline.

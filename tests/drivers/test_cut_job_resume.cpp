@@ -4,6 +4,7 @@
 
 #include <thread>
 
+#include "lamina/drivers/cell_io.hpp"
 #include "lamina/drivers/cut_job.hpp"
 #include "lamina/drivers/modbus_block_link.hpp"
 #include "lamina/drivers/streamer.hpp"
@@ -207,6 +208,40 @@ TEST(CutJobResume, ANewHostIgnoresTheAcksMeantForTheOneThatDied) {
   ASSERT_EQ(log.size(), first.size() + second.size());
   for (std::size_t i = 0; i < first.size(); ++i) ASSERT_EQ(log[i].line, first[i]) << "block " << i + 1;
   for (std::size_t i = 0; i < second.size(); ++i) ASSERT_EQ(log[first.size() + i].line, second[i]);
+}
+
+// The CNC's cable is pulled mid-cut and put back (issue 16, item 7): the stop is safe (the PLC
+// holds the machine, jet off), and the operator's resume opens the port again before its reset
+// — it used to reset over the closed port and fail with "no banner after the soft reset".
+TEST(CutJobResume, AfterAnUnplugAndReplugTheResumeOpensThePortAgain) {
+  TempDir dir;
+  const auto program = contour_program(4, 100);
+  SimProcess sim({"--link", dir.file("cnc"), "--log", dir.file("exec.jsonl"), "--control", "127.0.0.1:0",
+                  "--modbus", "127.0.0.1:0", "--pressure-ramp", "0.2", "--time-scale", "2"});
+  auto link = pty_link(dir.file("cnc"));
+  CellIoSettings cell_settings;
+  cell_settings.plc.port = sim.modbus_port();
+  CellIo cell(cell_settings);
+  CutJob job(*link, &cell, program);
+  std::thread fault([&] {
+    sim::testing::wait_status(sim.control_port(), [](const nlohmann::json& st) { return st["executed_blocks"] > 150; }, 30);
+    sim::testing::control(sim.control_port(), "unplug");
+  });
+  CutReport r = job.run();
+  fault.join();
+  ASSERT_EQ(r.state, CutState::stopped) << (r.reason ? r.reason->message : "");
+  EXPECT_EQ(r.reason->code, LinkErrorCode::io_error) << r.reason->message;
+  ASSERT_TRUE(r.resume);
+  ASSERT_EQ(sim::testing::control(sim.control_port(), "replug"), "ok");
+  ASSERT_TRUE(sim::testing::wait_status(sim.control_port(), [](const nlohmann::json& st) { return st["plugged"] == true; }, 10));
+  const std::size_t restart = r.resume->restart_index;
+  r = job.resume();
+  ASSERT_EQ(r.state, CutState::completed) << (r.reason ? r.reason->message : "");
+  // The resumed run is the program from the restart contour to its end, every line once.
+  const auto log = records(dir.file("exec.jsonl"));
+  ASSERT_GE(log.size(), program.size() - restart);
+  const std::size_t tail = log.size() - (program.size() - restart);
+  for (std::size_t i = 0; i < program.size() - restart; ++i) EXPECT_EQ(log[tail + i].line, program[restart + i]);
 }
 
 TEST(CutJobResume, DripFeedStoppedByThePlcResumesFromTheContourStart) { pressure_drop_then_resume("xonxoff"); }
