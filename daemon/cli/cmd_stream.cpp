@@ -154,6 +154,10 @@ int run_stream(const StreamOptions& o) {
   finished = true;
   watcher.join();
   progress.clear();
+  // The stop kept the pump pressurised for a resume; this program is leaving, so nobody will
+  // resume: jet, abrasive and pump off (a completed cut did that already).
+  if (cell && report.state != drivers::CutState::completed)
+    if (auto off = cell->finish_cut(); !off) spdlog::error("cell: could not turn the pump off: {}", off.error().message);
 
   const double utilisation = line_bytes_per_s > 0 && report.seconds > 0
                                  ? static_cast<double>(report.bytes_sent) / (report.seconds * line_bytes_per_s)

@@ -15,6 +15,7 @@
 #include <thread>
 
 #include "link_test_support.hpp"
+#include "modbus_test_client.hpp"
 
 namespace lamina::drivers::testing {
 namespace {
@@ -144,6 +145,25 @@ TEST(HostStop, InterruptTurnsTheJetOff) {
   EXPECT_EQ(run.summary["state"], "stopped") << run.output;
   EXPECT_EQ(run.summary["reason"]["code"], "cancelled") << run.output;
   expect_safe(sim, dir);
+}
+
+// With the cell's PLC, Ctrl-C leaves the cell safe too (issue 16, item 4): the program is
+// leaving and nobody will resume, so pump and abrasive go off with the jet.
+TEST(HostStop, InterruptWithThePlcTurnsPumpAndAbrasiveOff) {
+  TempDir dir;
+  SimProcess sim(sim_args(dir, {"--modbus", "127.0.0.1:0", "--pressure-ramp", "0.2"}));
+  const auto program = pierce_program("G4P0.1", 2000, 300);
+  BackgroundStream run_in_background(dir, fmt::format("'{}' --port '{}' --modbus 127.0.0.1:{}", write_program(dir, program),
+                                                      dir.file("cnc"), sim.modbus_port()));
+  ASSERT_TRUE(sim::testing::wait_status(sim.control_port(), jet_on, 30));
+  PlcProbe plc(sim.modbus_port());
+  ASSERT_EQ(plc.coil(map::kCoilPump), 1);
+  ASSERT_TRUE(run_in_background.signal(SIGINT));
+  const CliRun run = run_in_background.finish();
+  EXPECT_EQ(run.summary["reason"]["code"], "cancelled") << run.output;
+  EXPECT_EQ(plc.coil(map::kCoilJet), 0);
+  EXPECT_EQ(plc.coil(map::kCoilAbrasive), 0);
+  EXPECT_EQ(plc.coil(map::kCoilPump), 0) << run.output;
 }
 
 // An earlier host left the controller in Hold:0 with the jet on. `lamina stream` says so before
