@@ -27,11 +27,16 @@ std::expected<std::string, RpcError> string_param(const Json& params, const char
   return it->get<std::string>();
 }
 
-std::expected<int, RpcError> int_param(const Json& params, const char* key) {
+// An integer within [min, max]: read wide and checked, never narrowed (get<int>() of
+// 4294967297 is 1, which confirmed sheet 1).
+std::expected<int, RpcError> int_param(const Json& params, const char* key, int min, int max) {
   auto it = params.find(key);
   if (it == params.end()) return std::unexpected(invalid(fmt::format("params.{}: missing", key)));
   if (!it->is_number_integer()) return std::unexpected(invalid(fmt::format("params.{}: expected an integer", key)));
-  return it->get<int>();
+  const bool too_big = it->is_number_unsigned() && it->get<std::uint64_t>() > static_cast<std::uint64_t>(max);
+  if (too_big || it->get<std::int64_t>() < min || it->get<std::int64_t>() > max)
+    return std::unexpected(invalid(fmt::format("params.{}: {} is out of range {} … {}", key, it->dump(), min, max)));
+  return static_cast<int>(it->get<std::int64_t>());
 }
 
 RpcResult job_result(std::expected<JobRecord, RpcError> r) {
@@ -125,7 +130,7 @@ RpcServer::Handler make_api_handler(JobManager& jobs, Uploads& uploads, ServerIn
   m["job.cancel"] = with_job([&jobs](const std::string& id, const Json&) { return jobs.cancel(id); });
   m["job.resume"] = with_job([&jobs](const std::string& id, const Json&) { return jobs.resume(id); });
   m["job.confirm_sheet"] = with_job([&jobs](const std::string& id, const Json& params) -> std::expected<JobRecord, RpcError> {
-    auto sheet = int_param(params, "sheet");
+    auto sheet = int_param(params, "sheet", 1, 100000);
     if (!sheet) return std::unexpected(sheet.error());
     return jobs.confirm_sheet(id, *sheet);
   });

@@ -1,5 +1,6 @@
 #include "uploads.hpp"
 
+#include <algorithm>
 #include <array>
 #include <fstream>
 #include <optional>
@@ -65,8 +66,11 @@ Uploads::Uploads(fs::path dir, UploadLimits limits) : dir_(std::move(dir)), limi
 }
 
 std::expected<std::string, RpcError> Uploads::begin(const std::string& file_name, std::uint64_t size_bytes) {
-  if (file_name.empty() || file_name.size() > 200 || file_name.find('/') != std::string::npos || file_name[0] == '.')
-    return std::unexpected(invalid("params.name: a plain file name (no folders), e.g. part.stl"));
+  const bool control_char = std::any_of(file_name.begin(), file_name.end(),
+                                        [](char c) { return static_cast<unsigned char>(c) < 0x20 || c == 0x7F; });
+  if (file_name.empty() || file_name.size() > 200 || file_name.find('/') != std::string::npos || file_name[0] == '.' ||
+      control_char)  // a NUL would cut the name on disk short of what the client was told
+    return std::unexpected(invalid("params.name: a plain file name (no folders, no control characters), e.g. part.stl"));
   if (!model_extension(file_name)) return std::unexpected(invalid("params.name: an .stl, .obj or .3mf file"));
   if (size_bytes == 0 || size_bytes > limits_.max_file_bytes)
     return std::unexpected(invalid(fmt::format("params.size: 1 … {} bytes", limits_.max_file_bytes)));

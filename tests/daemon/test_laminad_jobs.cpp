@@ -48,6 +48,14 @@ TEST(LaminadJobs, SubmittedModelIsPlannedAndEverySheetCutLineForLine) {
   auto wrong = c.call("job.confirm_sheet", {{"job", id}, {"sheet", 2}});
   ASSERT_FALSE(wrong);
   EXPECT_EQ(wrong.error().code, -32602);
+  // Integers are range-checked, not narrowed: 4294967297 is not sheet 1 (issue 16, item 10).
+  for (const Json sheet : {Json(4294967297LL), Json(-1), Json(0), Json(18446744073709551615ULL)}) {
+    auto out_of_range = c.call("job.confirm_sheet", {{"job", id}, {"sheet", sheet}});
+    ASSERT_FALSE(out_of_range) << sheet;
+    EXPECT_EQ(out_of_range.error().code, -32602) << sheet;
+    EXPECT_NE(out_of_range.error().message.find("out of range"), std::string::npos) << out_of_range.error().message;
+  }
+  EXPECT_TRUE(executed(cell.log()).empty()) << "nothing was confirmed";
 
   job = run_to_completion(c, id, 300);
   ASSERT_EQ(job["state"], "completed") << job.dump(2) << daemon.log();
