@@ -49,7 +49,7 @@ TEST(LaminadJobs, SubmittedModelIsPlannedAndEverySheetCutLineForLine) {
   ASSERT_FALSE(wrong);
   EXPECT_EQ(wrong.error().code, -32602);
   // Integers are range-checked, not narrowed: 4294967297 is not sheet 1 (issue 16, item 10).
-  for (const Json sheet : {Json(4294967297LL), Json(-1), Json(0), Json(18446744073709551615ULL)}) {
+  for (const Json& sheet : {Json(4294967297LL), Json(-1), Json(0), Json(18446744073709551615ULL)}) {
     auto out_of_range = c.call("job.confirm_sheet", {{"job", id}, {"sheet", sheet}});
     ASSERT_FALSE(out_of_range) << sheet;
     EXPECT_EQ(out_of_range.error().code, -32602) << sheet;

@@ -61,7 +61,7 @@ TEST(Uploads, NamesSizesAndDataAreChecked) {
     EXPECT_NE(r.error().message.find("params.name"), std::string::npos) << r.error().message;
   }
   // A NUL (or any control character) would cut the name on disk short of the one checked.
-  for (const std::string bad : {std::string("part\0.txt.stl", 13), std::string("part\n.stl")}) {
+  for (const std::string& bad : {std::string("part\0.txt.stl", 13), std::string("part\n.stl")}) {
     auto r = uploads.begin(bad, 10);
     ASSERT_FALSE(r);
     EXPECT_NE(r.error().message.find("control characters"), std::string::npos) << r.error().message;
