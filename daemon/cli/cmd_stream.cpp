@@ -60,6 +60,35 @@ std::expected<std::vector<std::string>, std::string> read_program(const std::str
 std::atomic<bool> g_interrupted{false};
 extern "C" void on_sigint(int) { g_interrupted = true; }
 
+// The end of a stream: one JSON line for a script (--json), or two lines for a person.
+void print_summary(const drivers::CutReport& report, drivers::MachineLink* link, double line_bytes_per_s, bool json) {
+  const double utilisation = line_bytes_per_s > 0 && report.seconds > 0
+                                 ? static_cast<double>(report.bytes_sent) / (report.seconds * line_bytes_per_s)
+                                 : 0;
+  if (json) {
+    nlohmann::json j{{"state", drivers::to_string(report.state)},
+                     {"lines", report.lines_total},
+                     {"lines_accepted", report.lines_accepted},
+                     {"bytes", report.bytes_sent},
+                     {"seconds", report.seconds},
+                     {"link_utilisation", utilisation},
+                     {"first_unfinished_line", report.first_unfinished_line + 1}};
+    if (report.reason) j["reason"] = {{"code", drivers::to_string(report.reason->code)}, {"message", report.reason->message}};
+    if (report.resume) j["resume"] = {{"line", report.resume->restart_index + 1}, {"contour", report.resume->contour}};
+    if (auto* s = dynamic_cast<drivers::Streamer*>(link)) {
+      const auto l = s->realtime_latency();
+      j["realtime_latency_ms"] = {{"max", l.max_s * 1e3}, {"mean", l.mean_s * 1e3}, {"count", l.count}};
+    }
+    fmt::print("{}\n", j.dump());
+  } else {
+    fmt::print("{}: {} of {} lines, {} bytes in {:.1f} s", drivers::to_string(report.state), report.lines_accepted,
+               report.lines_total, report.bytes_sent, report.seconds);
+    if (utilisation > 0) fmt::print(", link {:.0f} % busy", 100 * utilisation);
+    fmt::print("\n");
+    if (report.reason) fmt::print("reason: {}\n", report.reason->message);
+  }
+}
+
 int run_stream(const StreamOptions& o) {
   // Logs go to stderr: stdout carries the summary (--json) a script reads.
   spdlog::set_default_logger(spdlog::stderr_color_mt("link"));
@@ -159,31 +188,7 @@ int run_stream(const StreamOptions& o) {
   if (cell && report.state != drivers::CutState::completed)
     if (auto off = cell->finish_cut(); !off) spdlog::error("cell: could not turn the pump off: {}", off.error().message);
 
-  const double utilisation = line_bytes_per_s > 0 && report.seconds > 0
-                                 ? static_cast<double>(report.bytes_sent) / (report.seconds * line_bytes_per_s)
-                                 : 0;
-  if (o.json) {
-    nlohmann::json j{{"state", drivers::to_string(report.state)},
-                     {"lines", report.lines_total},
-                     {"lines_accepted", report.lines_accepted},
-                     {"bytes", report.bytes_sent},
-                     {"seconds", report.seconds},
-                     {"link_utilisation", utilisation},
-                     {"first_unfinished_line", report.first_unfinished_line + 1}};
-    if (report.reason) j["reason"] = {{"code", drivers::to_string(report.reason->code)}, {"message", report.reason->message}};
-    if (report.resume) j["resume"] = {{"line", report.resume->restart_index + 1}, {"contour", report.resume->contour}};
-    if (auto* s = dynamic_cast<drivers::Streamer*>(link.get())) {
-      const auto l = s->realtime_latency();
-      j["realtime_latency_ms"] = {{"max", l.max_s * 1e3}, {"mean", l.mean_s * 1e3}, {"count", l.count}};
-    }
-    fmt::print("{}\n", j.dump());
-  } else {
-    fmt::print("{}: {} of {} lines, {} bytes in {:.1f} s", drivers::to_string(report.state), report.lines_accepted,
-               report.lines_total, report.bytes_sent, report.seconds);
-    if (utilisation > 0) fmt::print(", link {:.0f} % busy", 100 * utilisation);
-    fmt::print("\n");
-    if (report.reason) fmt::print("reason: {}\n", report.reason->message);
-  }
+  print_summary(report, link.get(), line_bytes_per_s, o.json);
   return report.state == drivers::CutState::completed ? 0 : 1;
 }
 
