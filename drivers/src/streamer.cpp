@@ -259,7 +259,9 @@ struct Streamer::Impl {
         finish(LinkError{LinkErrorCode::controller_error,
                          fmt::format("line {} refused: {}", r->index + 1, r->meaning)});
       } else if (const auto* a = std::get_if<ControllerAlarm>(&event)) {
-        finish(LinkError{LinkErrorCode::controller_alarm, fmt::format("alarm {}: {}", a->code, a->meaning)});
+        // Code 0: the protocol has no alarm numbers (a drip feed's NAK): no "alarm 0".
+        finish(LinkError{LinkErrorCode::controller_alarm,
+                         a->code == 0 ? a->meaning : fmt::format("alarm {}: {}", a->code, a->meaning)});
       } else if (const auto* reset = std::get_if<ControllerReset>(&event)) {
         resets_seen.fetch_add(1);
         if (awaiting_banner) {

@@ -6,6 +6,7 @@
 #include <poll.h>
 #include <pty.h>
 #include <stdexcept>
+#include <sys/ioctl.h>
 #include <sys/socket.h>
 #include <termios.h>
 #include <unistd.h>
@@ -16,6 +17,12 @@
 
 namespace lamina::sim {
 namespace {
+
+std::size_t bytes_readable(int fd) {
+  int n = 0;
+  if (fd < 0 || ::ioctl(fd, FIONREAD, &n) != 0 || n < 0) return 0;
+  return static_cast<std::size_t>(n);
+}
 
 class PtyPort final : public CncPort {
  public:
@@ -54,6 +61,7 @@ class PtyPort final : public CncPort {
     if (n >= 0) return n;
     return (errno == EAGAIN || errno == EINTR) ? 0 : -1;
   }
+  std::size_t input_waiting() const override { return present_ ? bytes_readable(master_) : 0; }
   void unplug() override { close_pty(); }
   void replug() override {
     if (master_ < 0) open_pty();
@@ -156,6 +164,7 @@ class TcpPort final : public CncPort {
     if (listen_fd_ < 0) listen_fd_ = listen_loopback(host_, port_);
   }
   bool plugged() const override { return listen_fd_ >= 0; }
+  std::size_t input_waiting() const override { return bytes_readable(client_); }
   int poll_fd() const override { return client_; }
   std::string describe() const override { return fmt::format("tcp {}:{}", host_, port_); }
   int port() const { return port_; }

@@ -20,6 +20,8 @@ class CncPort {
   // Non-blocking; 0 when nothing is there; -1 when the client is gone.
   virtual long read_some(std::uint8_t* buffer, std::size_t size) = 0;
   virtual long write_some(const std::uint8_t* data, std::size_t size) = 0;
+  // Bytes the client wrote that are waiting to be read (FIONREAD); 0 when none or no client.
+  virtual std::size_t input_waiting() const = 0;
   // Fault: pull the cable (close the PTY and remove the link / drop the TCP client and stop
   // listening). replug() brings the port back (a new PTY at the same link path).
   virtual void unplug() = 0;

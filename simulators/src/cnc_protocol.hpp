@@ -4,6 +4,7 @@
 // drains output at the same rate; the personality decides what a byte means.
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <string>
 
@@ -37,11 +38,22 @@ class CncProtocol {
   virtual void poll(double now_s) = 0;
   // Bytes to send to the client, in order (the link paces them).
   virtual std::string take_output() = 0;
+  // That many more of those bytes have crossed the wire (or were lost with nobody listening):
+  // a flow-control stop counts from when the sender could see it, not from when it was said.
+  virtual void on_output_sent(std::size_t /*bytes*/) {}
   // Fault: stop taking lines out of the receive buffer (the machine still runs its queue).
   virtual void set_stalled(bool stalled) = 0;
   // Operator-side reset / e-stop arrive through the PLC or the control socket.
   virtual void external_reset(double now_s) = 0;
   virtual std::size_t rx_free() const = 0;
+  // Flow control against the emulation's own lateness. On a real line the controller's UART
+  // takes bytes one at a time and turns the line round (DC3) at the byte that crosses its mark;
+  // this loop may wake late and find a burst waiting. input_room(): how many bytes the link may
+  // deliver now before asking again (unlimited unless the personality flow-controls).
+  // set_bytes_in_transit(n), called every loop: n bytes the sender wrote while the emulation
+  // was behind are waiting — on a real wire they had crossed before a stop could be sent.
+  virtual std::size_t input_room() const { return std::numeric_limits<std::size_t>::max(); }
+  virtual void set_bytes_in_transit(std::size_t /*bytes*/) {}
   virtual const ProtocolCounters& counters() const = 0;
 };
 

@@ -3,6 +3,7 @@
 #include <poll.h>
 #include <sstream>
 #include <stdexcept>
+#include <thread>
 #include <vector>
 
 #include <fmt/format.h>
@@ -113,7 +114,8 @@ void SimRuntime::run(const std::atomic<bool>& stop) {
   while (!stop.load()) {
     step();
     std::vector<pollfd> fds;
-    if (int fd = port_->poll_fd(); fd >= 0) fds.push_back({fd, POLLIN, 0});
+    // Input the controller cannot take yet stays in the port: no wake-up for it (a busy loop).
+    if (int fd = port_->poll_fd(); fd >= 0 && protocol_->input_room() > 0) fds.push_back({fd, POLLIN, 0});
     if (control_)
       for (int fd : control_->poll_fds()) fds.push_back({fd, POLLIN, 0});
     // 1 ms granularity: a byte at 115200 baud takes 87 µs, so bytes move in small bursts that
@@ -132,8 +134,8 @@ void SimRuntime::step() {
       log_.write_event("connect", now, {{"on_open", on_open_name(options_.on_open)}});
       // What the controller said before the host opened the port (the power-up banner
       // included) went nowhere, as on native USB before the host enumerates it.
-      tx_pending_.clear();
-      protocol_->take_output();
+      discard_output();
+      protocol_->on_output_sent(protocol_->take_output().size());
       switch (options_.on_open) {
         case OnOpen::banner: protocol_->on_connect(now); break;
         case OnOpen::reset:  // the reset prints the banner itself (after ALARM:3 if it was moving)
@@ -162,6 +164,7 @@ void SimRuntime::step() {
   protocol_->poll(now);
   tick_plc(now);
   for (const auto& event : machine_.take_events()) log_.write(event);
+  protocol_->set_bytes_in_transit(std::min(port_->input_waiting(), rx_pacer_.bytes_behind_bound()));
   tx_pending_ += protocol_->take_output();
   move_bytes_out(wall);
   if (control_) control_->serve([this](const std::string& line) { return handle_command(line); });
@@ -174,13 +177,16 @@ void SimRuntime::move_bytes_in(double wall, double now) {
   std::bernoulli_distribution garble(options_.faults.garble_probability);
   std::uniform_int_distribution<int> bit(0, 7);
   while (allowed > 0) {
-    const long n = port_->read_some(buffer, std::min(allowed, sizeof buffer));
+    const std::size_t room = protocol_->input_room();
+    if (room == 0) break;  // the controller is turning the line round (its DC3 goes out first)
+    const long n = port_->read_some(buffer, std::min({allowed, room, sizeof buffer}));
     if (n <= 0) {
       rx_pacer_.idle();  // the client's queue is empty: the wire idles
       break;
     }
     rx_pacer_.consume(static_cast<std::size_t>(n));
     allowed -= static_cast<std::size_t>(n);
+    if (lag_pending_s_) oversleep(now);
     for (long i = 0; i < n; ++i) {
       std::uint8_t byte = buffer[i];
       if (options_.faults.garble_probability > 0 && garble(garble_rng_)) {
@@ -204,6 +210,15 @@ void SimRuntime::move_bytes_in(double wall, double now) {
   }
 }
 
+// The emulation's own fault: the process sleeps as a loaded machine deschedules it, right
+// after bytes arrived (mid-stream, when the sender is busy). The sender goes on writing on its
+// own clock; what the wire would have carried meanwhile is waiting when the loop wakes.
+void SimRuntime::oversleep(double now) {
+  const double s = *std::exchange(lag_pending_s_, std::nullopt);
+  log_.write_event("lag", now, {{"ms", s * 1000}});
+  std::this_thread::sleep_for(std::chrono::duration<double>(s));
+}
+
 // Hold, resume and reset as they reach the controller, stamped on CLOCK_MONOTONIC (steady_clock),
 // which every process on the machine shares: a host that notes when it asked can measure its
 // real-time path to the controller, queues and pacing included (bench/hold_latency). Status
@@ -224,7 +239,7 @@ void SimRuntime::log_realtime_byte(std::uint8_t byte, double now) {
 void SimRuntime::move_bytes_out(double wall) {
   std::size_t allowed = tx_pacer_.allowance(wall);
   if (!port_->client_present()) {
-    tx_pending_.clear();  // nobody on the line: what the controller says is lost
+    discard_output();  // nobody on the line: what the controller says is lost
     return;
   }
   if (tx_pending_.empty()) tx_pacer_.idle();  // nothing to say: the wire idles
@@ -232,10 +247,16 @@ void SimRuntime::move_bytes_out(double wall) {
     const std::size_t n = std::min(allowed, tx_pending_.size());
     const long written = port_->write_some(reinterpret_cast<const std::uint8_t*>(tx_pending_.data()), n);
     if (written <= 0) break;
+    protocol_->on_output_sent(static_cast<std::size_t>(written));
     tx_pacer_.consume(static_cast<std::size_t>(written));
     allowed -= static_cast<std::size_t>(written);
     tx_pending_.erase(0, static_cast<std::size_t>(written));
   }
+}
+
+void SimRuntime::discard_output() {
+  protocol_->on_output_sent(tx_pending_.size());
+  tx_pending_.clear();
 }
 
 // The CNC's reset, whoever pressed it: the controller stops and flushes (protocol), and a
@@ -295,7 +316,7 @@ void SimRuntime::tick_plc(double now) {
 void SimRuntime::unplug(double now, const std::string& why) {
   if (!port_->plugged()) return;
   port_->unplug();
-  tx_pending_.clear();
+  discard_output();
   ++unplugs_;
   unplugged_by_fault_ = true;
   log_.write_event("unplug", now, {{"why", why}, {"line_ends_in", line_ends_in_}});
@@ -387,6 +408,12 @@ std::string SimRuntime::handle_command(const std::string& line) {
       log_.write_event("stall", now, {{"ms", ms}, {"source", "control"}});
       return "ok";
     }
+    if (verb == "lag") {
+      const double ms = std::stod(arg);
+      if (!(ms > 0)) return "error: lag MS needs a positive number of milliseconds";
+      lag_pending_s_ = ms / 1000.0;
+      return "ok";
+    }
     if (verb == "unplug") {
       unplug(now, "control");
       return "ok";
@@ -416,7 +443,7 @@ std::string SimRuntime::handle_command(const std::string& line) {
     return fmt::format("error: '{}' needs a number, got '{}'", verb, arg);
   }
   return fmt::format("error: unknown command '{}' (status, estop on|off, door open|closed, pressure drop|restore, "
-                     "stall MS, unplug, replug, alarm N, reset, garble P)", line);
+                     "stall MS, lag MS, unplug, replug, alarm N, reset, garble P)", line);
 }
 
 }  // namespace lamina::sim

@@ -40,6 +40,8 @@ class SimRuntime {
   void step();
   void move_bytes_in(double wall, double now);
   void move_bytes_out(double wall);
+  void discard_output();
+  void oversleep(double now);
   void log_realtime_byte(std::uint8_t byte, double now);
   void tick_plc(double now);
   void reset_cnc(double now, const char* source);  // takes the PLC lock
@@ -68,6 +70,7 @@ class SimRuntime {
   bool unplugged_by_fault_ = false;
   std::optional<double> replug_at_wall_;
   std::optional<double> stall_until_wall_;
+  std::optional<double> lag_pending_s_;  // control `lag MS`: sleep once, after the next bytes read
   bool schedule_unplug_done_ = false, schedule_estop_done_ = false, schedule_pressure_done_ = false,
        schedule_stall_done_ = false;
   std::uint64_t unplugs_ = 0;

@@ -49,11 +49,15 @@ class XonXoffProtocol final : public CncProtocol {
       rx_state_ = RxState::wait_start;  // the closing `%` (still stored: it ends the last line)
     }
     // The sender needs a few characters to react to DC3; beyond the margin it is overrunning.
-    // Counted from when the DC3 went out: bytes taken in the same late wake-up as the one that
-    // crossed the high-water mark were on the wire before the sender could have seen it.
-    if (xoff_ && xoff_on_wire_ && ++bytes_since_xoff_ > params_.overrun_margin_bytes) {
-      overflow(now_s);
-      return;
+    // Counted from when the DC3 went out, and not for bytes that were already waiting then
+    // because the emulation slept (input_room() hands those over only as they fit).
+    if (xoff_ && xoff_on_wire_) {
+      if (transit_exempt_ > 0) {
+        --transit_exempt_;
+      } else if (++bytes_since_xoff_ > params_.overrun_margin_bytes) {
+        overflow(now_s);
+        return;
+      }
     }
     if (buf_.size() >= params_.buffer_bytes) {
       overflow(now_s);
@@ -61,11 +65,7 @@ class XonXoffProtocol final : public CncProtocol {
     }
     buf_.push_back(static_cast<char>(byte));
     ++counters_.bytes_received;
-    if (!xoff_ && buf_.size() > params_.high_water_bytes) {
-      out_ += kDc3;
-      xoff_ = true;
-      bytes_since_xoff_ = 0;
-    }
+    if (!xoff_ && buf_.size() > params_.high_water_bytes) say_xoff();
   }
 
   void poll(double now_s) override {
@@ -82,18 +82,40 @@ class XonXoffProtocol final : public CncProtocol {
       if (check_alarm()) return;
     }
     if (xoff_ && buf_.size() < params_.low_water_bytes) {
-      out_ += kDc1;
+        out_ += kDc1;
       xoff_ = xoff_on_wire_ = false;
+      transit_exempt_ = 0;
     }
   }
 
   std::string take_output() override {
-    if (xoff_ && !xoff_on_wire_) {
-      xoff_on_wire_ = true;
-      bytes_since_xoff_ = 0;
-    }
+    taken_bytes_ += out_.size();
     return std::exchange(out_, {});
   }
+  void on_output_sent(std::size_t bytes) override {
+    sent_bytes_ += bytes;
+    if (xoff_ && !xoff_on_wire_ && sent_bytes_ >= xoff_end_) {
+      xoff_on_wire_ = true;
+      bytes_since_xoff_ = 0;
+      transit_exempt_ = rx_state_ == RxState::halted ? 0 : bytes_in_transit_;
+    }
+  }
+
+  // Up to the byte that crosses the high-water mark; none while that DC3 waits to go out;
+  // after it, the bytes that were in transit only as they fit with the margin still free for
+  // what the sender writes before it sees the DC3 (those come after them); then anything (an
+  // overrun is the sender's and raises the alarm).
+  std::size_t input_room() const override {
+    if (rx_state_ == RxState::halted) return std::numeric_limits<std::size_t>::max();
+    if (!xoff_) return buf_.size() <= params_.high_water_bytes ? params_.high_water_bytes + 1 - buf_.size() : 1;
+    if (!xoff_on_wire_) return 0;
+    if (transit_exempt_ > 0) {
+      const std::size_t free = rx_free(), margin = params_.overrun_margin_bytes;
+      return std::min(transit_exempt_, free > margin ? free - margin : 0);
+    }
+    return std::numeric_limits<std::size_t>::max();
+  }
+  void set_bytes_in_transit(std::size_t bytes) override { bytes_in_transit_ = bytes; }
   void set_stalled(bool stalled) override { stalled_ = stalled; }
 
   void external_reset(double now_s) override {
@@ -174,13 +196,21 @@ class XonXoffProtocol final : public CncProtocol {
 
   // DC3 + reason; the buffer is flushed and input is lost until the machine is ready again.
   void halt(char reason) {
-    out_ += kDc3;
+    say_xoff();
     out_ += reason;
-    xoff_ = true;
-    bytes_since_xoff_ = 0;
+    transit_exempt_ = 0;
     buf_.clear();
     rx_state_ = RxState::halted;
     reset_line_state();
+  }
+
+  // DC3 into the output; the sender can see it once the output up to it has crossed the wire.
+  void say_xoff() {
+    out_ += kDc3;
+    xoff_end_ = taken_bytes_ + out_.size();
+    xoff_ = true;
+    xoff_on_wire_ = false;
+    bytes_since_xoff_ = 0;
   }
 
   void reset_line_state() {
@@ -195,8 +225,13 @@ class XonXoffProtocol final : public CncProtocol {
   ProtocolCounters counters_;
   RxState rx_state_ = RxState::wait_start;
   bool xoff_ = false;                  // DC3 sent, DC1 not yet
-  bool xoff_on_wire_ = false;          // that DC3 has left (take_output): the sender can see it
+  bool xoff_on_wire_ = false;          // that DC3 has crossed the wire: the sender can see it
+  std::uint64_t taken_bytes_ = 0;      // output handed to the link so far
+  std::uint64_t sent_bytes_ = 0;       // of it, what crossed the wire
+  std::uint64_t xoff_end_ = 0;         // output position just past the last DC3
   std::size_t bytes_since_xoff_ = 0;
+  std::size_t bytes_in_transit_ = 0;  // waiting in the port because the emulation slept
+  std::size_t transit_exempt_ = 0;    // of those, not yet taken since the DC3 went out
   bool stalled_ = false;
   char last_eol_ = 0;
   bool swallow_eob_ = false;

@@ -94,12 +94,12 @@ TEST_P(LinkFault, StopsSafelyWithAReasonAndDoesNotResume) {
 INSTANTIATE_TEST_SUITE_P(
     EveryInjectedFault, LinkFault,
     ::testing::Values(
-        FaultCase{"garbled_bytes", "grbl", {"--garble", "0.003", "--seed", "3"}, {"controller_error", "protocol_error", "timeout", "controller_alarm"}, ""},
-        FaultCase{"lost_ok", "grbl", {"--drop-ok", "120"}, {"protocol_error"}, "acknowledgement lost", true},
-        FaultCase{"unplugged", "grbl", {"--unplug-at-line", "200"}, {"io_error"}, "cnc"},
-        FaultCase{"alarm", "grbl", {"--alarm-at-line", "150"}, {"controller_alarm"}, "alarm 1"},
-        FaultCase{"estop", "grbl", {"--estop-at", "1.5"}, {"interlock", "controller_alarm"}, "stop"},
-        FaultCase{"pressure_drop", "grbl", {"--pressure-drop-at", "1.5"}, {"interlock"}, "pressure"},
+        FaultCase{"garbled_bytes", "grbl", {"--garble", "0.003", "--seed", "3"}, {"controller_error", "protocol_error", "timeout", "controller_alarm"}, "", false, ""},
+        FaultCase{"lost_ok", "grbl", {"--drop-ok", "120"}, {"protocol_error"}, "acknowledgement lost", true, ""},
+        FaultCase{"unplugged", "grbl", {"--unplug-at-line", "200"}, {"io_error"}, "cnc", false, ""},
+        FaultCase{"alarm", "grbl", {"--alarm-at-line", "150"}, {"controller_alarm"}, "alarm 1", false, ""},
+        FaultCase{"estop", "grbl", {"--estop-at", "1.5"}, {"interlock", "controller_alarm"}, "stop", false, ""},
+        FaultCase{"pressure_drop", "grbl", {"--pressure-drop-at", "1.5"}, {"interlock"}, "pressure", false, ""},
         FaultCase{"stall", "grbl", {}, {"timeout"}, "stalled", false, "stall 15000"}),
     [](const ::testing::TestParamInfo<FaultCase>& info) { return std::string(info.param.name); });
 
@@ -108,14 +108,14 @@ INSTANTIATE_TEST_SUITE_P(
 INSTANTIATE_TEST_SUITE_P(
     OtherProtocols, LinkFault,
     ::testing::Values(
-        FaultCase{"send_response_alarm", "send-response", {"--alarm-at-line", "150"}, {"controller_alarm"}, "alarm 1"},
-        FaultCase{"send_response_unplugged", "send-response", {"--unplug-at-line", "200"}, {"io_error"}, "cnc"},
-        FaultCase{"xonxoff_alarm", "xonxoff", {"--alarm-at-line", "150"}, {"controller_alarm"}, "nak"},
-        FaultCase{"xonxoff_pressure_drop", "xonxoff", {"--pressure-drop-at", "1.5"}, {"interlock"}, "pressure"},
-        FaultCase{"xonxoff_estop", "xonxoff", {"--estop-at", "1.5"}, {"interlock", "controller_alarm"}, "stop"},
-        FaultCase{"modbus_alarm", "modbus", {"--alarm-at-line", "150"}, {"controller_alarm"}, "alarm"},
-        FaultCase{"modbus_pressure_drop", "modbus", {"--pressure-drop-at", "1.5"}, {"interlock"}, "pressure"},
-        FaultCase{"modbus_estop", "modbus", {"--estop-at", "1.5"}, {"interlock", "controller_alarm"}, "stop"}),
+        FaultCase{"send_response_alarm", "send-response", {"--alarm-at-line", "150"}, {"controller_alarm"}, "alarm 1", false, ""},
+        FaultCase{"send_response_unplugged", "send-response", {"--unplug-at-line", "200"}, {"io_error"}, "cnc", false, ""},
+        FaultCase{"xonxoff_alarm", "xonxoff", {"--alarm-at-line", "150"}, {"controller_alarm"}, "nak", false, ""},
+        FaultCase{"xonxoff_pressure_drop", "xonxoff", {"--pressure-drop-at", "1.5"}, {"interlock"}, "pressure", false, ""},
+        FaultCase{"xonxoff_estop", "xonxoff", {"--estop-at", "1.5"}, {"interlock", "controller_alarm"}, "stop", false, ""},
+        FaultCase{"modbus_alarm", "modbus", {"--alarm-at-line", "150"}, {"controller_alarm"}, "alarm", false, ""},
+        FaultCase{"modbus_pressure_drop", "modbus", {"--pressure-drop-at", "1.5"}, {"interlock"}, "pressure", false, ""},
+        FaultCase{"modbus_estop", "modbus", {"--estop-at", "1.5"}, {"interlock", "controller_alarm"}, "stop", false, ""}),
     [](const ::testing::TestParamInfo<FaultCase>& info) { return std::string(info.param.name); });
 
 }  // namespace

@@ -1,5 +1,8 @@
 // Every program line reaches the controller exactly once and in order, for every protocol:
 // `lamina stream` against lamina-sim, compared with the simulator's execution log.
+#include <algorithm>
+#include <thread>
+
 #include <gtest/gtest.h>
 
 #include "link_test_support.hpp"
@@ -70,6 +73,40 @@ TEST(LinkInvariants, XonXoffDripFeedDeliversEveryLineOnceInOrder) {
     return st["executed_blocks"] == program.size();
   }, 60));
   EXPECT_EQ(sim::testing::control_status(sim.control_port())["bytes_dropped"], 0) << "DC3 was honoured";
+  expect_log_equals_program(dir.file("exec.jsonl"), program);
+}
+
+// The controller's emulation is descheduled while the host drip-feeds (a loaded CI machine does
+// this to lamina-sim; `lag MS` makes it happen mid-burst, where it hurts). The host, pacing on
+// its own clock, goes on writing what the wire would have carried, and the simulator wakes to
+// find it all waiting at once. On a real line the controller's UART sends DC3 the moment the
+// high-water mark is crossed: the emulation must not turn its own lateness into an overrun
+// alarm the sender never caused (it did: alarm 87, the buffer full and the DC3 not yet sent).
+TEST(LinkInvariants, XonXoffDripFeedSurvivesTheControllerBeingDescheduled) {
+  TempDir dir;
+  const auto program = contour_program(3, 100);
+  SimProcess sim({"--personality", "xonxoff", "--link", dir.file("cnc"), "--log", dir.file("exec.jsonl"),
+                  "--rx-buffer", "256", "--planner-blocks", "8", "--time-scale", "2", "--control", "127.0.0.1:0"});
+  std::thread lagger([&] {
+    for (std::size_t round = 1; round <= 3; ++round) {
+      if (!sim::testing::wait_status(sim.control_port(), [&](const nlohmann::json& st) {
+            return st["executed_blocks"].get<std::size_t>() >= round * 60;
+          }, 60))
+        return;
+      sim::testing::control(sim.control_port(), "lag 300");
+    }
+  });
+  const CliRun run = run_lamina_stream(fmt::format("'{}' --port '{}' --protocol xonxoff", write_program(dir, program),
+                                                   dir.file("cnc")));
+  lagger.join();
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  ASSERT_TRUE(sim::testing::wait_status(sim.control_port(), [&](const nlohmann::json& st) {
+    return st["executed_blocks"] == program.size();
+  }, 60));
+  EXPECT_EQ(sim::testing::control_status(sim.control_port())["bytes_dropped"], 0);
+  const auto log = sim::testing::read_log(dir.file("exec.jsonl"));
+  EXPECT_EQ(std::count_if(log.begin(), log.end(), [](const nlohmann::json& r) { return r.value("event", "") == "lag"; }),
+            3) << "every lag came mid-stream";
   expect_log_equals_program(dir.file("exec.jsonl"), program);
 }
 

@@ -33,7 +33,7 @@ struct ProtocolHarness {
   void tick() {
     machine.advance(now_s);
     protocol->poll(now_s);
-    output += protocol->take_output();
+    take_output();
   }
   // Advance the clock in small steps so the protocol sees the machine's progress.
   void run_for(double seconds, double step_s = 0.01) {
@@ -44,8 +44,14 @@ struct ProtocolHarness {
     }
   }
   std::string take() {
-    output += protocol->take_output();
+    take_output();
     return std::exchange(output, {});
+  }
+  // What the controller says crosses at once (a wire with no delay).
+  void take_output() {
+    const std::string said = protocol->take_output();
+    protocol->on_output_sent(said.size());
+    output += said;
   }
   // Lines of the executed blocks so far (consumes the machine's events, which only the
   // process loop does in the program; the protocols never read them).
