@@ -35,6 +35,8 @@ struct StreamOptions {
   std::size_t rx_buffer = 0;
   double status_hz = 5;
   double stall_margin_s = 2;
+  double hold_limit_s = 600;
+  double jet_restart_s = 1.0;
   bool json = false;
   bool resume = false;  // resume automatically after a stop? never: only the keyboard's R
 };
@@ -152,6 +154,8 @@ int run_stream(const StreamOptions& o) {
 
   drivers::CutJobSettings job_settings;
   job_settings.wait_for_idle = o.protocol != "xonxoff";  // a drip feed reports no status
+  job_settings.hold_limit_s = o.hold_limit_s;
+  job_settings.jet_restart_s = o.jet_restart_s;
   drivers::CutJob job(*link, cell.get(), *program, job_settings);
   KeyboardControl keys;  // raw stdin while streaming when it is a terminal
   ProgressLine progress(program->size(), !o.json);
@@ -210,6 +214,11 @@ void add_stream_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--stall-margin", o->stall_margin_s,
                   "seconds Idle with lines unanswered (plus a dwell's P) before the link calls it a stall")
       ->check(CLI::Range(0.5, 600.0));
+  cmd->add_option("--hold-limit", o->hold_limit_s,
+                  "seconds a feed hold may stand (jet off through the PLC) before it becomes a stop")
+      ->check(CLI::Range(1.0, 86400.0));
+  cmd->add_option("--jet-restart", o->jet_restart_s, "seconds from the jet on to the motion when a hold resumes")
+      ->check(CLI::Range(0.0, 60.0));
   cmd->add_flag("--json", o->json, "print the summary as JSON (no progress bar)");
   cmd->callback([o, &exit_code] { exit_code = run_stream(*o); });
 }

@@ -175,7 +175,8 @@ constexpr std::array kServerKeys{"socket"sv, "socket_mode"sv, "socket_group"sv, 
 constexpr std::array kLinkKeys{"protocol"sv, "port"sv, "tcp"sv, "baud"sv, "rx_buffer"sv, "status_hz"sv, "stall_margin_s"sv};
 constexpr std::array kCellKeys{"enabled"sv, "modbus"sv, "modbus_unit"sv, "modbus_timeout_s"sv,
                                "modbus_reconnects"sv, "heartbeat_period_s"sv, "pump_ready_timeout_s"sv,
-                               "pressure_setpoint_mpa"sv, "abrasive_g_per_min"sv};
+                               "pressure_setpoint_mpa"sv, "abrasive_g_per_min"sv, "hold_limit_s"sv,
+                               "jet_restart_s"sv};
 constexpr std::array kPlannerKeys{"lamina"sv, "workers"sv, "machine"sv, "materials"sv, "timeout_s"sv};
 constexpr std::array kProtocols{"grbl"sv, "send-response"sv, "xonxoff"sv, "modbus"sv};
 
@@ -259,6 +260,8 @@ void read_cell(Section s, CellConfig& c) {
   // The PLC takes the set point in 0.1 MPa in a 16-bit register; real pumps stop well below.
   s.number("pressure_setpoint_mpa", c.pressure_setpoint_mpa, {0, 1000, true});
   s.number("abrasive_g_per_min", c.abrasive_g_per_min, {0, 10000});  // 0: pure water jet
+  s.number("hold_limit_s", c.hold_limit_s, {1, 86400});
+  s.number("jet_restart_s", c.jet_restart_s, {0, 60});
 }
 
 void read_planner(Section s, PlannerConfig& c) {

@@ -124,8 +124,9 @@ std::size_t JobManager::interrupted_resume_line(const SheetRecord& sheet, const 
     const std::uint64_t first = *sheet.executed_base + sheet.attempt_preamble_lines;
     if (count && *count >= first) {
       const std::size_t ran = static_cast<std::size_t>(*count - first);
-      std::size_t line = std::min(sheet.attempt_first_line + ran, program.size());
-      if (sheet.last_acked_line > 0) line = std::min(line, sheet.last_acked_line);  // cannot have run unsent lines
+      // The count alone: the saved acknowledged line is up to one save period old (200 ms), so
+      // capping by it put the resume before a contour that had finished since — and cut it twice.
+      const std::size_t line = std::min(sheet.attempt_first_line + ran, program.size());
       note = fmt::format("placed by the CNC's executed-block count ({} since the attempt began)", ran);
       return line;
     }

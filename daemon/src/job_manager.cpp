@@ -280,8 +280,7 @@ std::expected<JobRecord, RpcError> JobManager::resume(const std::string& id) {
   if (!job) return std::unexpected(error(rpc_code::job_not_found, fmt::format("no job {}", id)));
   if (job->state == JobState::paused && pause_ == PauseKind::hold && cutting_) {
     drivers::CutJob* cut = cut_.get();
-    cut->continue_motion();
-    if (machine_.cell()) machine_.cell()->cycle_start();
+    cut->continue_motion();  // jet on again first, then the cycle start (line and PLC): CutJob's hold watch
     pause_ = PauseKind::none;
     (void)set_state(*job, JobState::cutting);
     return *job;
@@ -326,8 +325,7 @@ std::expected<nlohmann::json, RpcError> JobManager::hold() {
     pause_ = PauseKind::hold;
     (void)set_state(*job, JobState::paused, "held by the operator");
   }
-  cut->hold();
-  if (machine_.cell()) machine_.cell()->feed_hold();  // a drip feed has no hold on its line
+  cut->hold();  // the line's real-time byte and the PLC's button (a drip feed has no hold on its line)
   return nlohmann::json{{"held", true}};
 }
 

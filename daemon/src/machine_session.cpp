@@ -35,7 +35,8 @@ nlohmann::json position_json(const std::optional<std::array<double, 5>>& p) {
 
 }  // namespace
 
-MachineSession::MachineSession(const DaemonConfig& config) : link_config_(config.link) {
+MachineSession::MachineSession(const DaemonConfig& config)
+    : link_config_(config.link), hold_limit_s_(config.cell.hold_limit_s), jet_restart_s_(config.cell.jet_restart_s) {
   const MachineLinkConfig& l = config.link;
   if (l.protocol == "modbus") {
     drivers::ModbusBlockSettings s;
@@ -81,6 +82,8 @@ MachineSession::MachineSession(const DaemonConfig& config) : link_config_(config
 drivers::CutJobSettings MachineSession::cut_settings() const {
   drivers::CutJobSettings s;
   s.wait_for_idle = link_config_.protocol != "xonxoff";  // a drip feed reports no status
+  s.hold_limit_s = hold_limit_s_;
+  s.jet_restart_s = jet_restart_s_;
   return s;
 }
 

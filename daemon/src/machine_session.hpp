@@ -26,6 +26,7 @@ class MachineSession {
 
  private:
   MachineLinkConfig link_config_;
+  double hold_limit_s_ = 600, jet_restart_s_ = 1.0;  // [cell]: what a feed hold does to the jet
   std::string describe_;
   std::unique_ptr<drivers::MachineLink> link_;
   std::unique_ptr<drivers::CellIo> cell_;

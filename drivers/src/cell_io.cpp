@@ -31,7 +31,7 @@ LinkError interlock(std::string message) { return {LinkErrorCode::interlock, std
 }  // namespace
 
 struct CellIo::Impl {
-  enum class Kind { prepare, finish, reset_cnc, hold_cnc, refresh };
+  enum class Kind { prepare, finish, reset_cnc, hold_cnc, refresh, restore_jet };
   struct Command {
     Kind kind;
     std::promise<Result> done;
@@ -54,6 +54,7 @@ struct CellIo::Impl {
   std::condition_variable wake;
   std::deque<Command> commands;
   std::atomic<bool> jet_off_requested{false};
+  std::atomic<bool> jet_pause_requested{false};
   std::atomic<bool> feed_hold_requested{false};
   std::atomic<bool> cycle_start_requested{false};
   std::atomic<bool> stopping{false};
@@ -80,6 +81,7 @@ struct CellIo::Impl {
   void run() {
     while (true) {
       if (jet_off_requested.exchange(false)) write_jet_off("jet_off() requested");
+      if (jet_pause_requested.exchange(false)) pause_jet();
       if (feed_hold_requested.exchange(false)) {
         if (auto r = client.write_bit(pm::kCoilCncFeedHold, true); !r)
           log->warn("feed hold through the PLC: {}", r.error().message);
@@ -107,8 +109,8 @@ struct CellIo::Impl {
       std::unique_lock lock(mutex);
       wake.wait_until(lock, deadline,
                       [this] {
-                        return !commands.empty() || jet_off_requested || feed_hold_requested || cycle_start_requested ||
-                               stopping;
+                        return !commands.empty() || jet_off_requested || jet_pause_requested || feed_hold_requested ||
+                               cycle_start_requested || stopping;
                     });
     }
     // Best effort on the way out: the jet must not stay consented with nobody watching.
@@ -137,6 +139,7 @@ struct CellIo::Impl {
       case Kind::reset_cnc: return reset_cnc();
       case Kind::hold_cnc: return hold_cnc();
       case Kind::refresh: return read_inputs();
+      case Kind::restore_jet: return restore_jet();
     }
     return {};
   }
@@ -146,6 +149,28 @@ struct CellIo::Impl {
       log->error("jet off ({}) failed: {}", why, r.error().message);
     else
       log->info("jet off: {}", why);
+  }
+
+  // Jet first (the independent off path), then the abrasive: with no jet it would only fill
+  // the cutting head's mixing chamber.
+  void pause_jet() {
+    write_jet_off("the machine stands in a feed hold");
+    if (auto r = client.write_bit(pm::kCoilAbrasiveEnable, false); !r)
+      log->error("abrasive off (feed hold) failed: {}", r.error().message);
+  }
+
+  // Abrasive before the jet, as in prepare(); then the interlocks read back, so a resume into a
+  // cell that cannot cut (pressure gone while held) fails here instead of moving dry.
+  Result restore_jet() {
+    if (auto r = client.write_bit(pm::kCoilAbrasiveEnable, true); !r) return r;
+    if (auto r = client.write_bit(pm::kCoilJetOn, true); !r) return r;
+    if (auto r = read_inputs(); !r) return r;
+    if (auto f = check_interlocks(snapshot(), settings)) {
+      write_jet_off(f->message.c_str());
+      return std::unexpected(interlock("cannot resume the jet: " + f->message));
+    }
+    log->info("jet and abrasive on again after the feed hold");
+    return {};
   }
 
   // Discrete inputs and the first input registers, decoded into `status`.
@@ -362,6 +387,8 @@ std::expected<void, LinkError> CellIo::reset_cnc() { return impl_->submit(Impl::
 std::expected<void, LinkError> CellIo::hold_cnc() { return impl_->submit(Impl::Kind::hold_cnc); }
 void CellIo::feed_hold() { impl_->signal(impl_->feed_hold_requested); }
 void CellIo::cycle_start() { impl_->signal(impl_->cycle_start_requested); }
+void CellIo::pause_jet() { impl_->signal(impl_->jet_pause_requested); }
+std::expected<void, LinkError> CellIo::restore_jet() { return impl_->submit(Impl::Kind::restore_jet); }
 std::expected<void, LinkError> CellIo::refresh() { return impl_->submit(Impl::Kind::refresh); }
 
 void CellIo::on_fault(std::function<void(const CellFaultReport&)> callback) {

@@ -37,6 +37,7 @@ CutJob::CutJob(MachineLink& link, CellIo* cell, std::vector<std::string> program
 }
 
 CutJob::~CutJob() {
+  stop_hold_watch();
   if (cell_) cell_->on_fault(nullptr);
 }
 
@@ -52,8 +53,6 @@ void CutJob::set_state(CutState state) {
   report_.state = state;
 }
 
-void CutJob::hold() { link_.request(RealtimeCommand::feed_hold); }
-void CutJob::continue_motion() { link_.request(RealtimeCommand::resume); }
 
 void CutJob::abort(std::string why) {
   // Jet first: the PLC path does not wait for anything queued on the serial line.
@@ -166,6 +165,13 @@ std::optional<std::uint64_t> CutJob::executed_blocks(bool fresh) {
 }
 
 CutReport CutJob::stream_from(std::size_t from, std::vector<std::string> preamble) {
+  start_hold_watch();
+  CutReport r = stream_span(from, std::move(preamble));
+  stop_hold_watch();
+  return r;
+}
+
+CutReport CutJob::stream_span(std::size_t from, std::vector<std::string> preamble) {
   stopping_ = false;
   set_state(CutState::cutting);
   const auto started = Clock::now();
@@ -230,7 +236,7 @@ CutReport CutJob::stream_from(std::size_t from, std::vector<std::string> preambl
     std::size_t last_seen = seen;
     const auto deadline = Clock::now() + std::chrono::duration<double>(settings_.finish_timeout_s);
     if (!settings_.wait_for_idle) idle_reports = 2;
-    while (settings_.wait_for_idle && Clock::now() < deadline && !stopping_) {
+    while (settings_.wait_for_idle && Clock::now() < deadline && !stopping_ && !hold_stop()) {
       const LinkProgress p = link_.progress();
       if (p.statuses_received != last_seen && p.last_status) {
         last_seen = p.statuses_received;
@@ -244,7 +250,8 @@ CutReport CutJob::stream_from(std::size_t from, std::vector<std::string> preambl
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
     }
     if (stopping_ || idle_reports < 2) {
-      stop_safely(stop_reason_.value_or(LinkError{LinkErrorCode::timeout, "the machine did not finish the program"}));
+      stop_safely(stop_reason_.value_or(
+          hold_stop().value_or(LinkError{LinkErrorCode::timeout, "the machine did not finish the program"})));
       return report();
     }
     if (cell_) (void)cell_->finish_cut();

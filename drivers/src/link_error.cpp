@@ -17,6 +17,8 @@ const char* to_string(LinkErrorCode code) {
     case LinkErrorCode::cancelled: return "cancelled";
     case LinkErrorCode::bad_request: return "bad_request";
     case LinkErrorCode::controller_held: return "controller_held";
+    case LinkErrorCode::held_too_long: return "held_too_long";
+    case LinkErrorCode::left_hold_without_jet: return "left_hold_without_jet";
   }
   return "unknown";
 }

@@ -157,7 +157,14 @@ void Plc::advance(double now_s) {
     hopper_kg_ = std::max(0.0, hopper_kg_ - regs_.holding[mm::kHoldAbrasiveSetpoint] * dt / 60.0 / 1000.0);
 
   if (estop_pressed()) latch(mm::kAlarmEstop);
-  if (heartbeat_armed_ && now_s - last_heartbeat_s_ > config_.heartbeat_timeout_s) latch(mm::kAlarmHeartbeat);
+  if (heartbeat_armed_ && now_s - last_heartbeat_s_ > config_.heartbeat_timeout_s &&
+      !(alarm_causes_ & alarm_bit(mm::kAlarmHeartbeat))) {
+    latch(mm::kAlarmHeartbeat);
+    // Nobody supervises the cut any more: the jet goes off (the jet logic) and the motion is
+    // held through the CNC's feed-hold input, so the CNC does not run its queue on dry — the
+    // contours it would have moved through uncut would then count as executed.
+    buttons_.feed_hold = true;
+  }
 }
 
 void Plc::take_client_bits() {

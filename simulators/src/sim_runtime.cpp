@@ -164,6 +164,7 @@ void SimRuntime::step() {
   protocol_->poll(now);
   tick_plc(now);
   for (const auto& event : machine_.take_events()) log_.write(event);
+  log_jet_and_state(now);
   protocol_->set_bytes_in_transit(std::min(port_->input_waiting(), rx_pacer_.bytes_behind_bound()));
   tx_pending_ += protocol_->take_output();
   move_bytes_out(wall);
@@ -217,6 +218,26 @@ void SimRuntime::oversleep(double now) {
   const double s = *std::exchange(lag_pending_s_, std::nullopt);
   log_.write_event("lag", now, {{"ms", s * 1000}});
   std::this_thread::sleep_for(std::chrono::duration<double>(s));
+}
+
+// The jet as the part feels it: water flows while the CNC's M-code asks for it and (with a
+// PLC) the PLC's consent is on. Logged on change, and the machine's state on change, so a test
+// or the fault campaign can measure how long a jet stood on a machine that did not move.
+void SimRuntime::log_jet_and_state(double now) {
+  bool flowing = machine_.jet_commanded();
+  if (modbus_) {
+    std::lock_guard lock(plc_mutex_);
+    flowing = flowing && plc_.jet_is_on();
+  }
+  const char* state = state_name(machine_.state());
+  if (flowing != jet_flowing_) {
+    jet_flowing_ = flowing;
+    log_.write_event("jet", now, {{"flowing", flowing}, {"state", state}});
+  }
+  if (state != logged_state_) {
+    logged_state_ = state;
+    log_.write_event("state", now, {{"state", state}, {"jet", flowing}});
+  }
 }
 
 // Hold, resume and reset as they reach the controller, stamped on CLOCK_MONOTONIC (steady_clock),

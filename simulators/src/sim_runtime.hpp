@@ -42,6 +42,7 @@ class SimRuntime {
   void move_bytes_out(double wall);
   void discard_output();
   void oversleep(double now);
+  void log_jet_and_state(double now);
   void log_realtime_byte(std::uint8_t byte, double now);
   void tick_plc(double now);
   void reset_cnc(double now, const char* source);  // takes the PLC lock
@@ -74,6 +75,8 @@ class SimRuntime {
   bool schedule_unplug_done_ = false, schedule_estop_done_ = false, schedule_pressure_done_ = false,
        schedule_stall_done_ = false;
   std::uint64_t unplugs_ = 0;
+  bool jet_flowing_ = false;                 // as last logged ("jet" events)
+  std::string logged_state_ = "idle";        // as last logged ("state" events)
   std::uint64_t line_ends_in_ = 0;  // LF bytes that reached the controller (for --unplug-at-line)
 };
 

@@ -71,6 +71,8 @@ void expect_same(const DaemonConfig& a, const DaemonConfig& b) {
   EXPECT_EQ(a.cell.modbus_timeout_s, b.cell.modbus_timeout_s);
   EXPECT_EQ(a.cell.modbus_reconnects, b.cell.modbus_reconnects);
   EXPECT_EQ(a.cell.heartbeat_period_s, b.cell.heartbeat_period_s);
+  EXPECT_EQ(a.cell.hold_limit_s, b.cell.hold_limit_s);
+  EXPECT_EQ(a.cell.jet_restart_s, b.cell.jet_restart_s);
   EXPECT_EQ(a.cell.pump_ready_timeout_s, b.cell.pump_ready_timeout_s);
   EXPECT_EQ(a.cell.pressure_setpoint_mpa, b.cell.pressure_setpoint_mpa);
   EXPECT_EQ(a.cell.abrasive_g_per_min, b.cell.abrasive_g_per_min);
@@ -96,7 +98,8 @@ TEST(DaemonConfig, TheDefaultsFileShowsEveryKey) {
   for (const char* key : {"state_dir", "socket", "socket_mode", "socket_group", "tcp", "token", "token_file",
                           "max_request_bytes", "protocol", "port", "baud", "rx_buffer", "status_hz", "enabled",
                           "modbus", "heartbeat_period_s", "pump_ready_timeout_s", "pressure_setpoint_mpa",
-                          "abrasive_g_per_min", "lamina", "workers", "machine", "materials", "timeout_s"})
+                          "abrasive_g_per_min", "hold_limit_s", "jet_restart_s", "lamina", "workers", "machine",
+                          "materials", "timeout_s"})
     EXPECT_NE(text.find(std::string("\n") + key + " = "), std::string::npos) << key;
 }
 

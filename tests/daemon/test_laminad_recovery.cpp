@@ -64,9 +64,9 @@ TEST_P(LaminadRecovery, KilledWhileCuttingComesBackInterruptedAndResumesOnReques
     std::this_thread::sleep_for(std::chrono::milliseconds(600));  // some progress saved
   }
   EXPECT_EQ(daemon->stop(SIGKILL), -SIGKILL);
-  // Without its heartbeat the PLC closes the jet; the CNC finishes what it had queued.
-  ASSERT_TRUE(sim::testing::wait_status(cell.sim.control_port(),
-                                        [](const Json& s) { return s["queued_blocks"] == 0 && s["state"] != "run"; }, 30));
+  // Without its heartbeat the PLC closes the jet and holds the CNC. Before, the CNC ran its
+  // queue on with the jet closed (and went idle), and the resume skipped those contours as run.
+  ASSERT_TRUE(sim::testing::wait_status(cell.sim.control_port(), [](const Json& s) { return s["state"] == "hold"; }, 30));
   const auto ran_before = executed(cell.log());
 
   daemon->start();

@@ -39,6 +39,8 @@ struct CellConfig {
   double pump_ready_timeout_s = 10;
   double pressure_setpoint_mpa = 380;
   double abrasive_g_per_min = 350;
+  double hold_limit_s = 600;    // a feed hold (jet off) longer than this becomes a stop
+  double jet_restart_s = 1.0;   // resume from a hold: jet on, this long, then the motion
 };
 
 struct PlannerConfig {

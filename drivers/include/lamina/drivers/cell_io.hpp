@@ -76,6 +76,12 @@ class CellIo {
   void feed_hold();
   // The PLC's cycle-start button (coil cnc_cycle_start): continues a held drip feed.
   void cycle_start();
+  // A feed hold that stands still: jet and abrasive feed off now, from any thread (as
+  // jet_off(), the abrasive after it); the pump stays pressurised for the resume.
+  void pause_jet();
+  // The resume of such a hold, blocking: abrasive feed on, jet consent on, and the PLC read
+  // back — an error when the cell cannot cut any more (e-stop, door, pressure).
+  std::expected<void, LinkError> restore_jet();
   // Blocking: read the PLC's inputs now (status() is otherwise refreshed only while a cut is
   // prepared and monitored) — e.g. the CNC's executed-block count after a restart.
   std::expected<void, LinkError> refresh();

@@ -5,12 +5,14 @@
 // operator. It never resumes by itself: resume() is the operator's call, and restarts at the
 // start of the contour that was being cut (resume_point.hpp).
 #include <atomic>
+#include <condition_variable>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <mutex>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "lamina/drivers/cell_io.hpp"
@@ -27,6 +29,11 @@ struct CutJobSettings {
   // Wait for the controller to report Idle after the last line (needs status reports). A drip
   // feed has none: its cut is done, as far as the link can tell, when the last byte is out.
   bool wait_for_idle = true;
+  // A feed hold that stands still turns the jet off through the PLC (hold_guard.hpp); resume
+  // opens it and waits jet_restart_s before the motion continues; a hold longer than
+  // hold_limit_s is a stop. Without a PLC a standing hold cannot turn the jet off: it is a stop.
+  double hold_limit_s = 600;
+  double jet_restart_s = 1.0;
 };
 
 enum class CutState { ready, preparing, cutting, stopping, stopped, completed, failed };
@@ -68,7 +75,9 @@ class CutJob {
   CutReport resume_from(std::size_t first_unfinished_line);
 
   // From any thread (keyboard, daemon): feed hold / cycle start without stopping the job, and
-  // abort (stops the job like a fault, reason cancelled).
+  // abort (stops the job like a fault, reason cancelled). Both go over the line and through
+  // the PLC's buttons (a drip feed has no hold on its line). While a program streams, the
+  // resume after a hold that turned the jet off first opens it again (never blocks the caller).
   void hold();
   void continue_motion();
   void abort(std::string why);
@@ -77,7 +86,8 @@ class CutJob {
   void on_progress(std::function<void(const CutReport&)> callback);
 
  private:
-  CutReport stream_from(std::size_t from, std::vector<std::string> preamble);
+  CutReport stream_from(std::size_t from, std::vector<std::string> preamble);  // with the hold watch
+  CutReport stream_span(std::size_t from, std::vector<std::string> preamble);
   bool refuse_unsendable();
   // Blocks the CNC has finished, from the link's status or the PLC's (nullopt: neither says).
   std::optional<std::uint64_t> executed_blocks(bool fresh);
@@ -85,6 +95,13 @@ class CutJob {
   std::optional<LinkError> jet_off_without_plc(bool axes_still);
   std::function<void(const CellFaultReport&)> fault_handler();
   void set_state(CutState state);
+  // The hold watch: a thread beside stream_from that applies the hold rule to the state the
+  // controller (or the PLC) reports, and carries out the operator's resume.
+  void start_hold_watch();
+  void stop_hold_watch();
+  void watch_holds();
+  ControllerState observed_state() const;
+  std::optional<LinkError> hold_stop() const;
 
   MachineLink& link_;
   CellIo* cell_;
@@ -103,6 +120,12 @@ class CutJob {
   // program line from + k has run once the count passes base + preamble + k.
   std::optional<std::uint64_t> executed_base_;
   std::size_t preamble_lines_ = 0;
+  std::thread hold_thread_;
+  mutable std::mutex hold_mutex_;  // guards the four below
+  std::condition_variable hold_wake_;
+  bool hold_watching_ = false;
+  bool resume_requested_ = false;
+  std::optional<LinkError> hold_stop_;  // the hold rule stopped the job (read by stream_from)
 };
 
 }  // namespace lamina::drivers

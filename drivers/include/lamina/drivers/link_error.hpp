@@ -19,6 +19,8 @@ enum class LinkErrorCode : int {
   cancelled = 11,         // the operator or the caller stopped it
   bad_request = 12,       // a malformed argument (address, settings)
   controller_held = 13,   // in feed hold or with its door open before our first line: it would run nothing
+  held_too_long = 14,     // a feed hold outlasted [cut] hold_limit_s: it became a stop
+  left_hold_without_jet = 15,  // the machine left a hold by itself while the hold had the jet off
 };
 
 struct LinkError {

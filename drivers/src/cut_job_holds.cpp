@@ -1,0 +1,119 @@
+// CutJob's hold watch (issue 16, item 1): the rule is hold_guard.hpp; this file carries out
+// its actions on the cell and the link, on a thread of its own beside the stream, so neither
+// the operator's resume call nor the link's status callback ever waits on the PLC.
+#include <chrono>
+
+#include <spdlog/spdlog.h>
+
+#include "hold_guard.hpp"
+#include "lamina/drivers/cut_job.hpp"
+
+namespace lamina::drivers {
+namespace {
+using Clock = std::chrono::steady_clock;
+constexpr auto kWatchPeriod = std::chrono::milliseconds(20);
+}  // namespace
+
+void CutJob::hold() {
+  link_.request(RealtimeCommand::feed_hold);
+  if (cell_) cell_->feed_hold();  // the only hold a drip feed has; a second one for grbl
+}
+
+void CutJob::continue_motion() {
+  {
+    std::lock_guard lock(hold_mutex_);
+    if (hold_watching_) {
+      resume_requested_ = true;
+      hold_wake_.notify_all();
+      return;
+    }
+  }
+  link_.request(RealtimeCommand::resume);
+  if (cell_) cell_->cycle_start();
+}
+
+void CutJob::start_hold_watch() {
+  stop_hold_watch();
+  {
+    std::lock_guard lock(hold_mutex_);
+    hold_watching_ = true;
+    resume_requested_ = false;
+    hold_stop_.reset();
+  }
+  hold_thread_ = std::thread([this] { watch_holds(); });
+}
+
+void CutJob::stop_hold_watch() {
+  {
+    std::lock_guard lock(hold_mutex_);
+    hold_watching_ = false;
+  }
+  hold_wake_.notify_all();
+  if (hold_thread_.joinable()) hold_thread_.join();
+}
+
+std::optional<LinkError> CutJob::hold_stop() const {
+  std::lock_guard lock(hold_mutex_);
+  return hold_stop_;
+}
+
+// The link's own reports where it has them (grbl: `Hold:0` vs `Hold:1`), else the PLC's
+// reading of the CNC's state lamps (a drip feed, the mailbox).
+ControllerState CutJob::observed_state() const {
+  const LinkProgress p = link_.progress();
+  if (p.statuses_received > 0 && p.last_status) return p.last_status->state;
+  if (cell_) return cell_->status().cnc_state;
+  return ControllerState::unknown;
+}
+
+void CutJob::watch_holds() {
+  detail::HoldGuard guard({.hold_limit_s = settings_.hold_limit_s, .jet_restart_s = settings_.jet_restart_s});
+  const auto t0 = Clock::now();
+  const auto stop_job = [&](LinkError why) {
+    spdlog::warn("cut: {}", why.message);
+    {
+      std::lock_guard lock(hold_mutex_);
+      hold_stop_ = why;
+    }
+    link_.stop(std::move(why));
+  };
+  const auto act = [&](detail::HoldAction action) {
+    switch (action) {
+      case detail::HoldAction::none: return;
+      case detail::HoldAction::jet_off:
+        if (!cell_)
+          return stop_job({LinkErrorCode::held_too_long,
+                           "the machine stands in a feed hold and there is no PLC to turn the jet off: stopped"});
+        spdlog::info("cut: the machine stands in a feed hold: jet and abrasive off");
+        return cell_->pause_jet();
+      case detail::HoldAction::jet_on:
+        if (!cell_) return;
+        spdlog::info("cut: resuming the hold: jet and abrasive on, motion in {:.1f} s", settings_.jet_restart_s);
+        if (auto r = cell_->restore_jet(); !r) stop_job(r.error());
+        return;
+      case detail::HoldAction::cycle_start:
+        link_.request(RealtimeCommand::resume);
+        if (cell_) cell_->cycle_start();
+        return;
+      case detail::HoldAction::stop: return stop_job(*guard.stop_reason());
+    }
+  };
+  std::unique_lock lock(hold_mutex_);
+  while (hold_watching_) {
+    hold_wake_.wait_for(lock, kWatchPeriod, [this] { return !hold_watching_ || resume_requested_; });
+    if (!hold_watching_) break;
+    const bool resume = std::exchange(resume_requested_, false);
+    lock.unlock();
+    const double now_s = std::chrono::duration<double>(Clock::now() - t0).count();
+    // Before our first line a held controller is the streamer's to report (controller_held).
+    if (!stopping_ && link_.progress().lines_sent > 0) {
+      if (resume) act(guard.on_resume_request(now_s));
+      act(guard.on_state(observed_state(), now_s));
+    } else if (resume && !stopping_) {
+      link_.request(RealtimeCommand::resume);  // nothing of ours is in the controller yet
+    }
+    lock.lock();
+  }
+}
+
+}  // namespace lamina::drivers
