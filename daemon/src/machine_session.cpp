@@ -1,5 +1,6 @@
 #include "machine_session.hpp"
 
+#include <chrono>
 #include <stdexcept>
 
 #include <boost/asio/io_context.hpp>
@@ -87,6 +88,27 @@ drivers::CutJobSettings MachineSession::cut_settings() const {
   return s;
 }
 
+// The PLC's values only while the PLC is reachable: unreachable (or never read), they read as
+// null — unknown — instead of the last ones (they showed jet on, 380 MPa with the PLC gone).
+// read_age_s says how old they are: between cuts nothing polls the PLC.
+static nlohmann::json cell_json(const drivers::CellStatus& c) {
+  const std::optional<double> age_s =
+      c.read_at ? std::optional(std::chrono::duration<double>(std::chrono::steady_clock::now() - *c.read_at).count())
+                : std::nullopt;
+  const bool fresh = c.connected && age_s;
+  const auto value = [&](auto v) { return fresh ? nlohmann::json(v) : nlohmann::json(nullptr); };
+  return {{"connected", c.connected},
+          {"read_age_s", age_s ? nlohmann::json(*age_s) : nlohmann::json(nullptr)},
+          {"estop_ok", value(c.estop_ok)},
+          {"door_closed", value(c.door_closed)},
+          {"pump_ready", value(c.pump_ready)},
+          {"jet_is_on", value(c.jet_is_on)},
+          {"pressure_mpa", value(c.pressure_mpa)},
+          {"abrasive_g_per_min", value(c.abrasive_g_per_min)},
+          {"alarm_latched", value(c.alarm_latched)},
+          {"alarm_code", value(c.alarm_code)}};
+}
+
 nlohmann::json MachineSession::status() const {
   const drivers::LinkProgress p = link_->progress();
   nlohmann::json j{{"link", describe_}, {"state", "unknown"}};
@@ -102,17 +124,8 @@ nlohmann::json MachineSession::status() const {
   j["lines_sent"] = p.lines_sent;
   j["lines_accepted"] = p.lines_accepted;
   if (cell_) {
-    const drivers::CellStatus c = cell_->status();
-    if (!p.last_status) j["state"] = drivers::to_string(c.cnc_state);
-    j["cell"] = {{"connected", c.connected},
-                 {"estop_ok", c.estop_ok},
-                 {"door_closed", c.door_closed},
-                 {"pump_ready", c.pump_ready},
-                 {"jet_is_on", c.jet_is_on},
-                 {"pressure_mpa", c.pressure_mpa},
-                 {"abrasive_g_per_min", c.abrasive_g_per_min},
-                 {"alarm_latched", c.alarm_latched},
-                 {"alarm_code", c.alarm_code}};
+    j["cell"] = cell_json(cell_->status());
+    if (!p.last_status && !j["cell"]["estop_ok"].is_null()) j["state"] = drivers::to_string(cell_->status().cnc_state);
     if (const auto f = cell_->fault()) j["cell"]["fault"] = f->message;
   }
   return j;

@@ -176,14 +176,25 @@ struct CellIo::Impl {
   // Discrete inputs and the first input registers, decoded into `status`.
   Result read_inputs() {
     auto bits = client.read_input_bits(0, pm::kInputCount);
-    if (!bits) return std::unexpected(bits.error());
+    if (!bits) return read_failed(bits.error());
     auto regs = client.read_input_registers(0, pm::kInExecutedHigh + 2);
-    if (!regs) return std::unexpected(regs.error());
+    if (!regs) return read_failed(regs.error());
     std::lock_guard lock(mutex);
     decode_cell_inputs(*bits, *regs, status);
+    status.read_at = Clock::now();
     status.connected = client.connected();
     status.reconnects = client.reconnects();
     return {};
+  }
+  // A reading that failed leaves the last values, but says whether the PLC is still there:
+  // status() readers show values of an unreachable PLC as unknown.
+  Result read_failed(LinkError error) {
+    {
+      std::lock_guard lock(mutex);
+      status.connected = client.connected();
+      status.reconnects = client.reconnects();
+    }
+    return std::unexpected(std::move(error));
   }
   CellStatus snapshot() const {
     std::lock_guard lock(mutex);

@@ -9,6 +9,7 @@
 #include "lamina/drivers/modbus_block_link.hpp"
 #include "lamina/drivers/streamer.hpp"
 #include "link_test_support.hpp"
+#include "pty_link.hpp"
 
 namespace lamina::drivers::testing {
 namespace {
@@ -60,20 +61,12 @@ void expect_resumed_once_from_contour_start(const std::vector<Record>& log, cons
   EXPECT_GT(done, restart - 1);
 }
 
-std::unique_ptr<Streamer> pty_link(const std::string& path) {
-  StreamerSettings settings;
-  settings.pace_bytes_per_s = 11520;
-  return std::make_unique<Streamer>(
-      [path](boost::asio::io_context& io) { return open_serial(io, path, SerialSettings{}); }, make_grbl_protocol(),
-      settings);
-}
-
 TEST(CutJobResume, AfterAnAlarmOnlyTheOperatorResumesFromTheContourStart) {
   TempDir dir;
   const auto program = contour_program(4, 100);
   SimProcess sim({"--link", dir.file("cnc"), "--log", dir.file("exec.jsonl"), "--control", "127.0.0.1:0",
                   "--alarm-at-line", "260", "--time-scale", "4"});
-  auto link = pty_link(dir.file("cnc"));
+  auto link = grbl_pty_link(dir.file("cnc"));
   CutJob job(*link, nullptr, program);
   CutReport r = job.run();
   ASSERT_EQ(r.state, CutState::stopped);
@@ -97,7 +90,7 @@ TEST(CutJobResume, AfterAFeedHoldStopTheQueueTellsExactlyWhatRan) {
   const auto program = contour_program(4, 100);
   SimProcess sim({"--link", dir.file("cnc"), "--log", dir.file("exec.jsonl"), "--control", "127.0.0.1:0",
                   "--time-scale", "2"});
-  auto link = pty_link(dir.file("cnc"));
+  auto link = grbl_pty_link(dir.file("cnc"));
   CutJob job(*link, nullptr, program);
   std::thread stopper([&] {
     std::this_thread::sleep_for(std::chrono::milliseconds(2500));  // well into the second contour
@@ -193,7 +186,7 @@ TEST(CutJobResume, ANewHostIgnoresTheAcksMeantForTheOneThatDied) {
     }, 10));
   }  // closed without reading a byte
   const std::vector<std::string> second{"G0X20", "G1X21F600", "G1X22F600", "G0X0"};
-  auto link = pty_link(dir.file("cnc"));
+  auto link = grbl_pty_link(dir.file("cnc"));
   link->start(LineSpan{second, 0}, {});
   const auto outcome = link->wait(30);
   ASSERT_TRUE(outcome);
@@ -218,7 +211,7 @@ TEST(CutJobResume, AfterAnUnplugAndReplugTheResumeOpensThePortAgain) {
   const auto program = contour_program(4, 100);
   SimProcess sim({"--link", dir.file("cnc"), "--log", dir.file("exec.jsonl"), "--control", "127.0.0.1:0",
                   "--modbus", "127.0.0.1:0", "--pressure-ramp", "0.2", "--time-scale", "2"});
-  auto link = pty_link(dir.file("cnc"));
+  auto link = grbl_pty_link(dir.file("cnc"));
   CellIoSettings cell_settings;
   cell_settings.plc.port = sim.modbus_port();
   CellIo cell(cell_settings);

@@ -9,6 +9,7 @@
 #include "lamina/drivers/cut_job.hpp"
 #include "lamina/drivers/streamer.hpp"
 #include "link_test_support.hpp"
+#include "pty_link.hpp"
 #include "modbus_test_client.hpp"
 
 namespace lamina::drivers::testing {
@@ -19,14 +20,6 @@ constexpr int kInAbrasiveFlow = 1;      // g/min (docs/modbus-map.md)
 constexpr int kCoilCncFeedHold = 4;     // the PLC's panel buttons
 constexpr int kCoilCncCycleStart = 5;
 
-std::unique_ptr<Streamer> grbl_link(const std::string& path) {
-  StreamerSettings settings;
-  settings.pace_bytes_per_s = 11520;
-  return std::make_unique<Streamer>(
-      [path](boost::asio::io_context& io) { return open_serial(io, path, SerialSettings{}); }, make_grbl_protocol(),
-      settings);
-}
-
 struct HeldCut {
   explicit HeldCut(CutJobSettings settings, bool with_plc = true)
       : sim([&] {
@@ -36,7 +29,7 @@ struct HeldCut {
           return args;
         }()),
         program(contour_program(3, 150)),
-        link(grbl_link(dir.file("cnc"))) {
+        link(grbl_pty_link(dir.file("cnc"))) {
     if (with_plc) {
       CellIoSettings cs;
       cs.plc.port = sim.modbus_port();

@@ -53,6 +53,9 @@ struct CellStatus {
   // program line) — how far a controller without a status report of its own has got.
   std::optional<std::uint64_t> cnc_executed_blocks;
   ControllerState cnc_state = ControllerState::unknown;  // the CNC's state lamps as the PLC wires them
+  // When the values above were last read from the PLC (nullopt: never). They are refreshed
+  // while a cut is monitored, by refresh(), and by the commands; otherwise they age.
+  std::optional<std::chrono::steady_clock::time_point> read_at;
 };
 
 class CellIo {
