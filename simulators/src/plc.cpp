@@ -160,10 +160,12 @@ void Plc::advance(double now_s) {
   if (heartbeat_armed_ && now_s - last_heartbeat_s_ > config_.heartbeat_timeout_s &&
       !(alarm_causes_ & alarm_bit(mm::kAlarmHeartbeat))) {
     latch(mm::kAlarmHeartbeat);
-    // Nobody supervises the cut any more: the jet goes off (the jet logic) and the motion is
-    // held through the CNC's feed-hold input, so the CNC does not run its queue on dry — the
-    // contours it would have moved through uncut would then count as executed.
-    buttons_.feed_hold = true;
+    // Nobody supervises the cut any more: the jet goes off (the jet logic) and a CNC in its
+    // cycle (moving, or its jet M-code on: a pierce dwell) is held through its feed-hold input,
+    // so it does not run its queue on dry — the contours it would have moved through uncut
+    // would then count as executed. An idle CNC is left alone: held, it would refuse the next
+    // sheet (controller_held), and between sheets the heartbeat stops by design.
+    if (cnc_.state == 1 || cnc_.jet_request) buttons_.feed_hold = true;
   }
 }
 

@@ -240,6 +240,22 @@ TEST(Plc, HeartbeatWatchdogIsArmedByTheFirstChange) {
   EXPECT_EQ(cell.in_reg(mm::kInHeartbeatSeen), 9);
 }
 
+// A supervisor that died mid-cut: the watchdog holds the CNC (it would run its queue on dry);
+// one that stopped beating between sheets leaves an idle CNC alone (held, it would refuse the
+// next sheet).
+TEST(Plc, HeartbeatTimeoutHoldsACncInItsCycleOnly) {
+  for (const bool cutting : {true, false}) {
+    Cell cell;
+    cell.ready_to_cut();
+    cell.cnc.state = cutting ? 1 : 0;
+    cell.cnc.jet_request = cutting;
+    cell.hold(mm::kHoldHeartbeat, 1);
+    cell.run_to(cell.now + 1.1);
+    ASSERT_TRUE(cell.input(mm::kInputAlarmLatched));
+    EXPECT_EQ(cell.plc.take_cnc_buttons().feed_hold, cutting) << (cutting ? "cutting" : "idle");
+  }
+}
+
 TEST(Plc, HeartbeatTimeoutLatchesAndResetNeedsHeartbeatsBack) {
   Cell cell;
   cell.ready_to_cut();
