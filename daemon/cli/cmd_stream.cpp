@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <expected>
 #include <chrono>
 #include <csignal>
 #include <fstream>
@@ -91,6 +92,68 @@ void print_summary(const drivers::CutReport& report, drivers::MachineLink* link,
   }
 }
 
+// The link and the cell the options name (issue 18 will share this with laminad's session).
+struct StreamRig {
+  std::unique_ptr<drivers::MachineLink> link;
+  std::unique_ptr<drivers::CellIo> cell;
+  double line_bytes_per_s = 0;  // 0: not a serial line
+};
+
+// The rig, or the exit code after a usage error was printed.
+std::expected<StreamRig, int> build_rig(const StreamOptions& o) {
+  StreamRig rig;
+  if (o.protocol == "modbus") {
+    if (o.modbus.empty()) {
+      fmt::print(stderr, "lamina stream: --protocol modbus needs --modbus HOST:PORT\n");
+      return std::unexpected(2);
+    }
+    drivers::ModbusBlockSettings s;
+    std::tie(s.plc.host, s.plc.port) = split_host_port(o.modbus, "--modbus");
+    s.status_period_s = 1.0 / o.status_hz;
+    rig.link = std::make_unique<drivers::ModbusBlockLink>(s);
+    drivers::CellIoSettings cs;  // the same PLC minds the pump and interlocks
+    cs.plc = s.plc;
+    rig.cell = std::make_unique<drivers::CellIo>(cs);
+    return rig;
+  }
+  if (o.port.empty() == o.tcp.empty()) {
+    fmt::print(stderr, "lamina stream: give --port DEVICE or --tcp HOST:PORT\n");
+    return std::unexpected(2);
+  }
+  std::unique_ptr<drivers::LineProtocol> protocol;
+  if (o.protocol == "grbl") protocol = drivers::make_grbl_protocol({o.rx_buffer});
+  else if (o.protocol == "send-response") protocol = drivers::make_send_response_protocol();
+  else protocol = drivers::make_xonxoff_protocol();
+  drivers::StreamerSettings settings;
+  settings.status_period_s = o.protocol == "xonxoff" ? 0 : 1.0 / o.status_hz;
+  settings.stall_margin_s = o.stall_margin_s;
+  drivers::TransportFactory open;
+  if (!o.port.empty()) {
+    drivers::SerialSettings serial;
+    serial.baud = o.baud;
+    rig.line_bytes_per_s = o.baud / 10.0;  // 8N1
+    settings.pace_bytes_per_s = rig.line_bytes_per_s;
+    open = [port = o.port, serial](boost::asio::io_context& io) { return drivers::open_serial(io, port, serial); };
+  } else {
+    const auto [host, port] = split_host_port(o.tcp, "--tcp");
+    open = [host, port](boost::asio::io_context& io) { return drivers::open_tcp(io, host, port); };
+  }
+  rig.link = std::make_unique<drivers::Streamer>(std::move(open), std::move(protocol), settings);
+  if (!o.modbus.empty()) {
+    drivers::CellIoSettings cs;
+    std::tie(cs.plc.host, cs.plc.port) = split_host_port(o.modbus, "--modbus");
+    rig.cell = std::make_unique<drivers::CellIo>(cs);
+  } else if (o.protocol == "xonxoff") {
+    // Without the PLC's jet output, a stop can only hold the feed; a drip feed has no reset
+    // on its line that would turn the controller's jet M-code off.
+    spdlog::warn("no --modbus: on a stop nothing turns the jet off (a drip feed has no reset on its line); "
+                 "use the cell's PLC");
+  } else {
+    spdlog::info("no --modbus: on a stop the controller is soft-reset once it stands still, to turn the jet off");
+  }
+  return rig;
+}
+
 int run_stream(const StreamOptions& o) {
   // Logs go to stderr: stdout carries the summary (--json) a script reads.
   spdlog::set_default_logger(spdlog::stderr_color_mt("link"));
@@ -99,58 +162,10 @@ int run_stream(const StreamOptions& o) {
     fmt::print(stderr, "lamina stream: {}\n", program.error());
     return 1;
   }
-  std::unique_ptr<drivers::MachineLink> link;
-  std::unique_ptr<drivers::CellIo> cell;
-  double line_bytes_per_s = 0;
-  if (o.protocol == "modbus") {
-    if (o.modbus.empty()) {
-      fmt::print(stderr, "lamina stream: --protocol modbus needs --modbus HOST:PORT\n");
-      return 2;
-    }
-    drivers::ModbusBlockSettings s;
-    std::tie(s.plc.host, s.plc.port) = split_host_port(o.modbus, "--modbus");
-    s.status_period_s = 1.0 / o.status_hz;
-    link = std::make_unique<drivers::ModbusBlockLink>(s);
-    drivers::CellIoSettings cs;  // the same PLC minds the pump and interlocks
-    cs.plc = s.plc;
-    cell = std::make_unique<drivers::CellIo>(cs);
-  } else {
-    if (o.port.empty() == o.tcp.empty()) {
-      fmt::print(stderr, "lamina stream: give --port DEVICE or --tcp HOST:PORT\n");
-      return 2;
-    }
-    std::unique_ptr<drivers::LineProtocol> protocol;
-    if (o.protocol == "grbl") protocol = drivers::make_grbl_protocol({o.rx_buffer});
-    else if (o.protocol == "send-response") protocol = drivers::make_send_response_protocol();
-    else protocol = drivers::make_xonxoff_protocol();
-    drivers::StreamerSettings settings;
-    settings.status_period_s = o.protocol == "xonxoff" ? 0 : 1.0 / o.status_hz;
-    settings.stall_margin_s = o.stall_margin_s;
-    drivers::TransportFactory open;
-    if (!o.port.empty()) {
-      drivers::SerialSettings serial;
-      serial.baud = o.baud;
-      line_bytes_per_s = o.baud / 10.0;  // 8N1
-      settings.pace_bytes_per_s = line_bytes_per_s;
-      open = [port = o.port, serial](boost::asio::io_context& io) { return drivers::open_serial(io, port, serial); };
-    } else {
-      const auto [host, port] = split_host_port(o.tcp, "--tcp");
-      open = [host, port](boost::asio::io_context& io) { return drivers::open_tcp(io, host, port); };
-    }
-    link = std::make_unique<drivers::Streamer>(std::move(open), std::move(protocol), settings);
-    if (!o.modbus.empty()) {
-      drivers::CellIoSettings cs;
-      std::tie(cs.plc.host, cs.plc.port) = split_host_port(o.modbus, "--modbus");
-      cell = std::make_unique<drivers::CellIo>(cs);
-    } else if (o.protocol == "xonxoff") {
-      // Without the PLC's jet output, a stop can only hold the feed; a drip feed has no reset
-      // on its line that would turn the controller's jet M-code off.
-      spdlog::warn("no --modbus: on a stop nothing turns the jet off (a drip feed has no reset on its line); "
-                   "use the cell's PLC");
-    } else {
-      spdlog::info("no --modbus: on a stop the controller is soft-reset once it stands still, to turn the jet off");
-    }
-  }
+  auto rig = build_rig(o);
+  if (!rig) return rig.error();
+  auto& link = rig->link;
+  auto& cell = rig->cell;
 
   drivers::CutJobSettings job_settings;
   job_settings.wait_for_idle = o.protocol != "xonxoff";  // a drip feed reports no status
@@ -192,7 +207,7 @@ int run_stream(const StreamOptions& o) {
   if (cell && report.state != drivers::CutState::completed)
     if (auto off = cell->finish_cut(); !off) spdlog::error("cell: could not turn the pump off: {}", off.error().message);
 
-  print_summary(report, link.get(), line_bytes_per_s, o.json);
+  print_summary(report, link.get(), rig->line_bytes_per_s, o.json);
   return report.state == drivers::CutState::completed ? 0 : 1;
 }
 

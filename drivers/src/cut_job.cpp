@@ -229,29 +229,8 @@ CutReport CutJob::stream_span(std::size_t from, std::vector<std::string> preambl
     outcome = link_.wait(settings_.stop_timeout_s);
   }
   if (outcome && outcome->completed) {
-    // Everything is in the controller; the cut is done when it has run it all (Idle, twice,
-    // in reports asked for after the last line went out).
-    const std::size_t seen = link_.progress().statuses_received;
-    int idle_reports = 0;
-    std::size_t last_seen = seen;
-    const auto deadline = Clock::now() + std::chrono::duration<double>(settings_.finish_timeout_s);
-    if (!settings_.wait_for_idle) idle_reports = 2;
-    while (settings_.wait_for_idle && Clock::now() < deadline && !stopping_ && !hold_stop()) {
-      const LinkProgress p = link_.progress();
-      if (p.statuses_received != last_seen && p.last_status) {
-        last_seen = p.statuses_received;
-        idle_reports = p.last_status->state == ControllerState::idle ? idle_reports + 1 : 0;
-        if (p.last_status->state == ControllerState::alarm) {
-          stop_safely(LinkError{LinkErrorCode::controller_alarm, "the controller alarmed while finishing the program"});
-          return report();
-        }
-        if (idle_reports >= 2) break;
-      }
-      std::this_thread::sleep_for(std::chrono::milliseconds(20));
-    }
-    if (stopping_ || idle_reports < 2) {
-      stop_safely(stop_reason_.value_or(
-          hold_stop().value_or(LinkError{LinkErrorCode::timeout, "the machine did not finish the program"})));
+    if (auto why = wait_until_run_out()) {
+      stop_safely(*why);
       return report();
     }
     if (cell_) (void)cell_->finish_cut();
@@ -268,6 +247,28 @@ CutReport CutJob::stream_span(std::size_t from, std::vector<std::string> preambl
   std::lock_guard lock(mutex_);
   report_.seconds += std::chrono::duration<double>(Clock::now() - started).count();
   return report_;
+}
+
+// Everything is in the controller; the cut is done when it has run it all (Idle, twice, in
+// reports asked for after the last line went out). nullopt when it has, else why it stops.
+std::optional<LinkError> CutJob::wait_until_run_out() {
+  if (!settings_.wait_for_idle) return std::nullopt;  // a drip feed reports nothing: out is done
+  int idle_reports = 0;
+  std::size_t last_seen = link_.progress().statuses_received;
+  const auto deadline = Clock::now() + std::chrono::duration<double>(settings_.finish_timeout_s);
+  while (Clock::now() < deadline && !stopping_ && !hold_stop()) {
+    const LinkProgress p = link_.progress();
+    if (p.statuses_received != last_seen && p.last_status) {
+      last_seen = p.statuses_received;
+      if (p.last_status->state == ControllerState::alarm)
+        return LinkError{LinkErrorCode::controller_alarm, "the controller alarmed while finishing the program"};
+      idle_reports = p.last_status->state == ControllerState::idle ? idle_reports + 1 : 0;
+      if (idle_reports >= 2) return std::nullopt;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  return stop_reason_.value_or(
+      hold_stop().value_or(LinkError{LinkErrorCode::timeout, "the machine did not finish the program"}));
 }
 
 // With no PLC the controller's own M-code is the only jet output, and a feed hold keeps it on:

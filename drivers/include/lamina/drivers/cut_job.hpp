@@ -88,6 +88,7 @@ class CutJob {
  private:
   CutReport stream_from(std::size_t from, std::vector<std::string> preamble);  // with the hold watch
   CutReport stream_span(std::size_t from, std::vector<std::string> preamble);
+  std::optional<LinkError> wait_until_run_out();
   bool refuse_unsendable();
   // Blocks the CNC has finished, from the link's status or the PLC's (nullopt: neither says).
   std::optional<std::uint64_t> executed_blocks(bool fresh);
