@@ -81,6 +81,11 @@ int run(const fs::path& config_path, bool check_only) {
     spdlog::error("state directory {}: {}", config->state_dir.string(), ec.message());
     return 1;
   }
+  // The default parts folder is ours to make; a configured one is the shop's (only noted).
+  for (const fs::path root : config->jobs.roots) {
+    if (root == config->state_dir / "parts") fs::create_directories(root, ec);
+    if (!fs::is_directory(root, ec)) spdlog::warn("[jobs] roots: {} is not a folder; no model can be named there", root.string());
+  }
   auto store = JobStore::open(config->state_dir / "lamina.db");
   if (!store) {
     spdlog::error("{}", store.error().message);
@@ -125,7 +130,8 @@ int run(const fs::path& config_path, bool check_only) {
   JobManager jobs(*config, **store, *machine, [&server_ptr](const std::string& method, const nlohmann::json& params) {
     if (server_ptr) server_ptr->broadcast(method, params);
   });
-  Uploads uploads(config->state_dir / "uploads");
+  Uploads uploads(config->state_dir / "uploads", UploadLimits{config->jobs.max_model_bytes, UploadLimits{}.max_chunk_bytes,
+                                                               config->jobs.max_uploads, config->jobs.upload_idle_s});
   RpcServer server(io, rs, make_api_handler(jobs, uploads, ServerInfo{kVersion, machine->describe(), config->state_dir.string()}));
   server_ptr = &server;
   for (int fd : activated)

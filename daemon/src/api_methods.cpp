@@ -1,5 +1,7 @@
 #include "api_methods.hpp"
 
+#include "plan_settings.hpp"
+
 #include <functional>
 #include <map>
 
@@ -82,12 +84,30 @@ RpcServer::Handler make_api_handler(JobManager& jobs, Uploads& uploads, ServerIn
     if (!received) return std::unexpected(received.error());
     return Json{{"received", *received}};
   };
+  m["upload.cancel"] = [&uploads](const Json& params, ClientContext&) -> RpcResult {
+    auto p = object_params(params);
+    if (!p) return std::unexpected(p.error());
+    auto id = string_param(params, "upload");
+    if (!id) return std::unexpected(id.error());
+    if (auto r = uploads.cancel(*id); !r) return std::unexpected(r.error());
+    return Json{{"cancelled", *id}};
+  };
   m["job.submit"] = [&jobs, &uploads](const Json& params, ClientContext&) -> RpcResult {
     auto p = object_params(params);
     if (!p) return std::unexpected(p.error());
     SubmitRequest r;
     if (params.contains("upload") == params.contains("model"))
       return std::unexpected(invalid("params: give either model (a path on the cell PC) or upload (from upload.begin)"));
+    for (const auto& [key, value] : params.items())
+      if (key != "model" && key != "upload" && key != "name" && key != "settings")
+        return std::unexpected(invalid(fmt::format("params.{}: unknown parameter", key)));
+    if (auto it = params.find("name"); it != params.end()) {
+      if (!it->is_string()) return std::unexpected(invalid("params.name: expected a string"));
+      r.name = it->get<std::string>();
+    }
+    if (auto it = params.find("settings"); it != params.end()) r.settings = *it;
+    // Checked before an upload is taken: a mistyped setting leaves the upload for the next try.
+    if (auto args = plan_args_from_settings(r.settings); !args) return std::unexpected(invalid(args.error()));
     if (params.contains("upload")) {
       auto id = string_param(params, "upload");
       if (!id) return std::unexpected(id.error());
@@ -100,14 +120,6 @@ RpcServer::Handler make_api_handler(JobManager& jobs, Uploads& uploads, ServerIn
       if (!model) return std::unexpected(model.error());
       r.model_path = *model;
     }
-    if (auto it = params.find("name"); it != params.end()) {
-      if (!it->is_string()) return std::unexpected(invalid("params.name: expected a string"));
-      r.name = it->get<std::string>();
-    }
-    if (auto it = params.find("settings"); it != params.end()) r.settings = *it;
-    for (const auto& [key, value] : params.items())
-      if (key != "model" && key != "upload" && key != "name" && key != "settings")
-        return std::unexpected(invalid(fmt::format("params.{}: unknown parameter", key)));
     return job_result(jobs.submit(std::move(r)));
   };
   m["job.list"] = [&jobs](const Json&, ClientContext&) -> RpcResult {

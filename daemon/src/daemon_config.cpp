@@ -119,6 +119,8 @@ class Section {
     return s != nullptr;
   }
 
+  void resolve(std::string& path) const { path = r_.resolve(path); }
+
   void path(std::string_view key, std::string& out) {
     std::string text = out;
     if (string(key, text) && node(key)) out = r_.resolve(text);
@@ -169,7 +171,7 @@ class Section {
 };
 
 constexpr std::array kRootKeys{"state_dir"sv};
-constexpr std::array kSections{"server"sv, "link"sv, "cell"sv, "planner"sv};
+constexpr std::array kSections{"server"sv, "link"sv, "cell"sv, "planner"sv, "jobs"sv};
 constexpr std::array kServerKeys{"socket"sv, "socket_mode"sv, "socket_group"sv, "tcp"sv, "token"sv, "token_file"sv,
                                  "max_request_bytes"sv};
 constexpr std::array kLinkKeys{"protocol"sv, "port"sv, "tcp"sv, "baud"sv, "rx_buffer"sv, "status_hz"sv, "stall_margin_s"sv};
@@ -177,7 +179,10 @@ constexpr std::array kCellKeys{"enabled"sv, "modbus"sv, "modbus_unit"sv, "modbus
                                "modbus_reconnects"sv, "heartbeat_period_s"sv, "pump_ready_timeout_s"sv,
                                "pressure_setpoint_mpa"sv, "abrasive_g_per_min"sv, "hold_limit_s"sv,
                                "jet_restart_s"sv};
-constexpr std::array kPlannerKeys{"lamina"sv, "workers"sv, "machine"sv, "materials"sv, "timeout_s"sv};
+constexpr std::array kPlannerKeys{"lamina"sv,    "workers"sv,          "machine"sv,     "materials"sv,
+                                  "timeout_s"sv, "memory_limit_mb"sv, "cpu_limit_s"sv, "nice"sv};
+constexpr std::array kJobsKeys{"roots"sv, "max_model_bytes"sv, "max_stock_file_bytes"sv, "upload_idle_s"sv,
+                               "max_uploads"sv};
 constexpr std::array kProtocols{"grbl"sv, "send-response"sv, "xonxoff"sv, "modbus"sv};
 
 // token, or token_file's contents; false when token_file was given and could not be used.
@@ -270,6 +275,46 @@ void read_planner(Section s, PlannerConfig& c) {
   s.path("machine", c.machine_file);
   s.path("materials", c.materials_file);
   s.number("timeout_s", c.timeout_s, {0, 7 * 24 * 3600, true});
+  s.integer("memory_limit_mb", c.memory_limit_mb, 0, std::int64_t{1} << 30);
+  if (c.memory_limit_mb != 0 && c.memory_limit_mb < 256) s.fail("memory_limit_mb", "0 (none) or at least 256");
+  s.number("cpu_limit_s", c.cpu_limit_s, {0, 7 * 24 * 3600});
+  s.integer("nice", c.nice, 0, 19);
+}
+
+// A root at or above the state directory, or inside its jobs/ or uploads/, would let a client
+// plan the job database or another job's files.
+bool holds_state(const fs::path& root, const fs::path& state_dir) {
+  const fs::path r = (root / "").lexically_normal(), st = (state_dir / "").lexically_normal();
+  const fs::path below = st.lexically_relative(r);  // state_dir seen from the root
+  if (!below.empty() && *below.begin() != "..") return true;
+  const fs::path inside = r.lexically_relative(st);
+  if (inside.empty() || *inside.begin() == "..") return false;
+  return *inside.begin() == "jobs" || *inside.begin() == "uploads";
+}
+
+// The folders a client may name files in. Absolute and distinct from the state directory's
+// own files: a root there would let a client plan another job's artefacts or the database.
+void read_jobs(Section s, JobsConfig& c, const fs::path& state_dir) {
+  if (const auto* n = s.node("roots")) {
+    const auto* list = n->as_array();
+    if (!list) return s.fail("roots", "expected a list of folders, e.g. [\"/srv/lamina/parts\"]");
+    for (const auto& item : *list) {
+      const auto* text = item.as_string();
+      if (!text || text->get().empty()) return s.fail("roots", "expected folder paths (non-empty strings)");
+      std::string folder = text->get();
+      s.resolve(folder);
+      if (!fs::path(folder).is_absolute()) return s.fail("roots", fmt::format("{}: expected an absolute folder", folder));
+      if (holds_state(folder, state_dir))
+        return s.fail("roots", fmt::format("{} holds the state directory's jobs or database; name a folder of parts",
+                                           folder));
+      c.roots.push_back(folder);
+    }
+  }
+  if (c.roots.empty()) c.roots.push_back((state_dir / "parts").string());
+  s.integer("max_model_bytes", c.max_model_bytes, 1024, std::int64_t{1} << 40);
+  s.integer("max_stock_file_bytes", c.max_stock_file_bytes, 64, std::int64_t{1} << 30);
+  s.number("upload_idle_s", c.upload_idle_s, {1, 7 * 24 * 3600});
+  s.integer("max_uploads", c.max_uploads, 1, 4096);
 }
 
 // How the machine is reached depends on the protocol: a line protocol goes over one serial port
@@ -329,6 +374,7 @@ std::expected<DaemonConfig, ConfigError> parse(const std::string& text, const st
   read_link(link, c.link);
   read_cell(Section(r, "cell", section_table(r, doc, "cell"), kCellKeys), c.cell);
   read_planner(Section(r, "planner", section_table(r, doc, "planner"), kPlannerKeys), c.planner);
+  read_jobs(Section(r, "jobs", section_table(r, doc, "jobs"), kJobsKeys), c.jobs, c.state_dir);
   check_link(link, c);
   if (r.failed()) return std::unexpected(r.error());
   return c;

@@ -2,6 +2,8 @@
 // planning. The cutting thread is in job_cutting.cpp.
 #include "job_manager.hpp"
 
+#include "client_files.hpp"
+
 #include <unistd.h>
 
 #include <chrono>
@@ -164,37 +166,64 @@ void JobManager::assign_machine() {
 
 // ---------------------------------------------------------------------------- requests
 
-std::expected<JobRecord, RpcError> JobManager::submit(SubmitRequest r) {
-  if (r.model_path.empty() || r.model_path.front() != '/')
-    return std::unexpected(error(rpc_code::invalid_params, "model: expected an absolute path on the cell PC"));
-  if (::access(r.model_path.c_str(), R_OK) != 0)
-    return std::unexpected(error(rpc_code::invalid_params, fmt::format("model: cannot read {}", r.model_path)));
-  auto args = plan_args_from_settings(r.settings);
-  if (!args) return std::unexpected(error(rpc_code::invalid_params, args.error()));
-
-  std::lock_guard lock(mutex_);
-  if (stopping_) return std::unexpected(error(rpc_code::shutting_down, "the daemon is stopping"));
-  JobRecord job;
-  job.id = new_job_id();
-  job.model_path = r.model_path;
-  job.name = r.name.empty() ? model_name(r.model_path) : r.name;
-  job.plan_settings = r.settings.is_null() ? nlohmann::json::object() : r.settings;
-  job.artefact_dir = (config_.state_dir / "jobs" / job.id).string();
-  job.created_unix_ms = job.updated_unix_ms = now_unix_ms();
+// The job's inputs go into its folder before it exists for anyone: an upload moves there, a
+// file named by path is checked against the roots and copied (client_files.hpp), and so is a
+// stock file. jobs/<id>/input/, apart from what the planner writes (a model named stack.stl
+// would otherwise be overwritten by the plan's own).
+std::expected<void, RpcError> JobManager::stage_inputs(JobRecord& job, const SubmitRequest& r) const {
+  const fs::path input = fs::path(job.artefact_dir) / "input";
+  std::vector<fs::path> roots(config_.jobs.roots.begin(), config_.jobs.roots.end());
   if (r.move_into_job) {
-    // An uploaded model belongs to its job: jobs/<id>/<name>, kept with the artefacts.
     std::error_code ec;
-    fs::create_directories(job.artefact_dir, ec);
+    fs::create_directories(input, ec);
     const std::string stored = fs::path(r.model_path).filename().string();  // "<upload id>-<name>"
-    const fs::path target = fs::path(job.artefact_dir) / stored.substr(stored.find('-') + 1);
+    const fs::path target = input / stored.substr(stored.find('-') + 1);
     fs::rename(r.model_path, target, ec);
     if (ec) return std::unexpected(error(rpc_code::storage_error, fmt::format("{}: {}", target.string(), ec.message())));
     job.model_path = target.string();
-    if (r.name.empty()) job.name = target.filename().string();
+  } else {
+    auto copy = import_client_file(r.model_path, "model", {roots, config_.jobs.max_model_bytes}, input);
+    if (!copy) return std::unexpected(copy.error());
+    job.model_path = copy->string();
   }
-  if (auto s = store_.insert_job(job); !s) return std::unexpected(error(rpc_code::storage_error, s.error().message));
-  event(job, "state", {{"from", nullptr}, {"to", "queued"}, {"reason", "submitted"}});
-  log()->info("job {}: queued ({})", job.id, job.model_path);
+  if (job.plan_settings.contains("stock_file")) {
+    auto copy = import_client_file(job.plan_settings["stock_file"].get<std::string>(), "settings.stock_file",
+                                   {roots, config_.jobs.max_stock_file_bytes}, input / "stock");
+    if (!copy) return std::unexpected(copy.error());
+    job.plan_settings["stock_file"] = copy->string();
+  }
+  return {};
+}
+
+std::expected<JobRecord, RpcError> JobManager::submit(SubmitRequest r) {
+  std::error_code ec;
+  auto fail = [&](RpcError e, const JobRecord* job) -> std::expected<JobRecord, RpcError> {
+    if (r.move_into_job) fs::remove(r.model_path, ec);  // a refused upload is not kept
+    if (job) fs::remove_all(job->artefact_dir, ec);
+    return std::unexpected(std::move(e));
+  };
+  auto args = plan_args_from_settings(r.settings);
+  if (!args) return fail(error(rpc_code::invalid_params, args.error()), nullptr);
+
+  JobRecord job;
+  job.id = new_job_id();
+  job.name = r.name.empty() ? model_name(r.model_path) : r.name;
+  if (r.move_into_job && r.name.empty()) {
+    const std::string stored = model_name(r.model_path);
+    job.name = stored.substr(stored.find('-') + 1);
+  }
+  job.plan_settings = r.settings.is_null() ? nlohmann::json::object() : r.settings;
+  job.artefact_dir = (config_.state_dir / "jobs" / job.id).string();
+  job.created_unix_ms = job.updated_unix_ms = now_unix_ms();
+  // File work outside the lock: a large model's copy must not hold up the cut's bookkeeping.
+  if (auto staged = stage_inputs(job, r); !staged) return fail(staged.error(), &job);
+
+  std::lock_guard lock(mutex_);
+  if (stopping_) return fail(error(rpc_code::shutting_down, "the daemon is stopping"), &job);
+  if (auto s = store_.insert_job(job); !s) return fail(error(rpc_code::storage_error, s.error().message), &job);
+  event(job, "state", {{"from", nullptr}, {"to", "queued"}, {"reason", "submitted"},
+                       {"source", r.move_into_job ? nlohmann::json("upload") : nlohmann::json(r.model_path)}});
+  log()->info("job {}: queued ({}, from {})", job.id, job.model_path, r.move_into_job ? "an upload" : r.model_path);
   jobs_[job.id] = job;
   plan_queue_.push_back(job.id);
   plan_wake_.notify_one();
@@ -395,6 +424,7 @@ void JobManager::plan_job(const std::string& id) {
     if (!config_.planner.materials_file.empty())
       request.flags.insert(request.flags.end(), {"--materials", config_.planner.materials_file});
     request.timeout_s = config_.planner.timeout_s;
+    request.limits = {config_.planner.memory_limit_mb << 20, config_.planner.cpu_limit_s, config_.planner.nice};
   }
   auto report = run_plan_process(request, *cancel, [this, &id](const nlohmann::json& phase) {
     nlohmann::json j;

@@ -28,7 +28,7 @@
 namespace lamina::daemon {
 
 struct SubmitRequest {
-  std::string model_path;             // absolute, readable by the daemon
+  std::string model_path;             // as the client named it (inside [jobs] roots), or the upload's file
   std::string name;                   // for people; default: the file name
   nlohmann::json settings = nlohmann::json::object();  // plan settings (plan_settings.hpp)
   bool move_into_job = false;         // an upload: the file moves into the job's folder
@@ -76,6 +76,7 @@ class JobManager {
   JobRecord* find(const std::string& id);
   const JobRecord* find(const std::string& id) const;
   void start_cut(JobRecord& job, CutStart how);
+  std::expected<void, RpcError> stage_inputs(JobRecord& job, const SubmitRequest& r) const;  // no lock needed
 
   // --- threads ---
   void planner_loop();

@@ -2,7 +2,7 @@
 
 #include <fcntl.h>
 #include <signal.h>
-#include <spawn.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -15,8 +15,6 @@
 #include <thread>
 
 #include <fmt/format.h>
-
-extern char** environ;
 
 namespace lamina::daemon {
 namespace {
@@ -32,6 +30,16 @@ std::string tail_of_log(const std::filesystem::path& log) {
     if (!line.empty()) last = line;
   }
   return errors.empty() ? last : errors;
+}
+
+// A planner killed by a signal: say which limit it ran into when that is what happened.
+std::string died_message(int signal, const PlanLimits& limits, const std::filesystem::path& log) {
+  std::string why;
+  if (signal == SIGXCPU || (signal == SIGKILL && limits.cpu_s > 0))
+    why = fmt::format(" (its CPU-time limit is {} s)", limits.cpu_s);
+  if ((signal == SIGSEGV || signal == SIGABRT || signal == SIGKILL) && limits.memory_bytes > 0)
+    why += fmt::format(" (its memory limit is {} MiB: [planner] memory_limit_mb)", limits.memory_bytes >> 20);
+  return fmt::format("the planner died (signal {}{}): {}", signal, why, tail_of_log(log));
 }
 
 // The descriptor the planner writes its phases to, as the child sees it.
@@ -53,6 +61,45 @@ void drain_progress(int fd, std::string& pending, const PlanProgressCallback& on
     if (!j.is_discarded() && j.is_object() && on_progress) on_progress(j);
   }
   if (pending.size() > 4096) pending.clear();  // not ours to keep: no line is that long
+}
+
+// After fork, in the child: only async-signal-safe calls (no allocation, no locks) until exec.
+// A limit the kernel refuses is written to the log and the planner runs without it.
+[[noreturn]] void exec_child(char* const* argv, int log_fd, int progress_fd, const PlanLimits& limits) {
+  auto note = [log_fd](const char* what) {
+    (void)!::write(log_fd, what, std::strlen(what));
+  };
+  if (limits.memory_bytes > 0) {
+    const rlimit as{static_cast<rlim_t>(limits.memory_bytes), static_cast<rlim_t>(limits.memory_bytes)};
+    if (::setrlimit(RLIMIT_AS, &as) != 0) note("warning: the planner's memory limit was refused\n");
+  }
+  if (limits.cpu_s > 0) {
+    // The soft limit sends SIGXCPU, the hard one (a second later) SIGKILL.
+    const rlimit cpu{static_cast<rlim_t>(limits.cpu_s), static_cast<rlim_t>(limits.cpu_s) + 1};
+    if (::setrlimit(RLIMIT_CPU, &cpu) != 0) note("warning: the planner's CPU limit was refused\n");
+  }
+  if (limits.nice > 0 && ::setpriority(PRIO_PROCESS, 0, limits.nice) != 0) note("warning: nice was refused\n");
+  // Under memory pressure the kernel kills the planner, never laminad cutting beside it.
+  if (const int adj = ::open("/proc/self/oom_score_adj", O_WRONLY | O_CLOEXEC); adj >= 0) {
+    (void)!::write(adj, "1000", 4);
+    ::close(adj);
+  }
+  // dup2 onto itself keeps O_CLOEXEC: the pipe that already is descriptor 3 must lose it here.
+  if (progress_fd == kProgressFd) ::fcntl(progress_fd, F_SETFD, 0);
+  const int devnull = ::open("/dev/null", O_RDONLY);
+  if (devnull < 0 || ::dup2(devnull, STDIN_FILENO) < 0 || ::dup2(log_fd, STDOUT_FILENO) < 0 ||
+      ::dup2(log_fd, STDERR_FILENO) < 0 || (progress_fd != kProgressFd && ::dup2(progress_fd, kProgressFd) < 0))
+    ::_exit(126);
+  ::execv(argv[0], argv);
+  note("error: cannot run the planner (exec failed)\n");
+  ::_exit(127);
+}
+
+// fork + limits + exec (posix_spawn cannot set rlimits); -1 and errno when fork fails.
+pid_t spawn_limited(std::vector<char*>& argv, int log_fd, int progress_fd, const PlanLimits& limits) {
+  const pid_t pid = ::fork();
+  if (pid == 0) exec_child(argv.data(), log_fd, progress_fd, limits);
+  return pid;
 }
 
 }  // namespace
@@ -85,17 +132,13 @@ std::expected<nlohmann::json, PlanProcessError> run_plan_process(const PlanProce
   for (auto& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
 
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
-  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0640);
-  posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
-  posix_spawn_file_actions_adddup2(&actions, progress_pipe[1], kProgressFd);  // dup2 drops O_CLOEXEC
-  pid_t pid = -1;
-  const int rc = ::posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), environ);
-  posix_spawn_file_actions_destroy(&actions);
-  if (rc != 0)
-    return std::unexpected(PlanProcessError{false, fmt::format("cannot start {}: {}", args[0], std::strerror(rc))});
+  const int log_fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0640);
+  if (log_fd < 0) return std::unexpected(PlanProcessError{false, fmt::format("{}: {}", log.string(), std::strerror(errno))});
+  const pid_t pid = spawn_limited(argv, log_fd, progress_pipe[1], r.limits);
+  const int spawn_errno = errno;
+  ::close(log_fd);
+  if (pid < 0)
+    return std::unexpected(PlanProcessError{false, fmt::format("cannot start {}: {}", args[0], std::strerror(spawn_errno))});
 
   ::close(progress_pipe[1]);  // the child holds the write end now
   progress_pipe[1] = -1;
@@ -126,8 +169,7 @@ std::expected<nlohmann::json, PlanProcessError> run_plan_process(const PlanProce
   }
   if (cancelled) return std::unexpected(PlanProcessError{true, "cancelled while planning"});
   if (timed_out) return std::unexpected(PlanProcessError{false, fmt::format("planning took longer than {} s", r.timeout_s)});
-  if (WIFSIGNALED(status))
-    return std::unexpected(PlanProcessError{false, fmt::format("the planner died (signal {}): {}", WTERMSIG(status), tail_of_log(log))});
+  if (WIFSIGNALED(status)) return std::unexpected(PlanProcessError{false, died_message(WTERMSIG(status), r.limits, log)});
   if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
     return std::unexpected(PlanProcessError{false, fmt::format("planning failed: {}", tail_of_log(log))});
 

@@ -4,6 +4,7 @@
 // the memory of a plan is returned to the system when it ends. The child writes its programs,
 // drawings, stack.stl and report.json into the job's folder; its output goes to plan.log there.
 #include <atomic>
+#include <cstdint>
 #include <expected>
 #include <filesystem>
 #include <functional>
@@ -14,12 +15,22 @@
 
 namespace lamina::daemon {
 
+// Limits of the child, set before it runs (setrlimit, nice): a huge or hostile model makes its
+// own job fail, never the cut beside it. Its oom_score_adj is 1000, so the kernel, short of
+// memory, kills the planner first.
+struct PlanLimits {
+  std::uint64_t memory_bytes = 0;     // RLIMIT_AS; 0: none
+  double cpu_s = 0;                   // RLIMIT_CPU; 0: none
+  int nice = 0;
+};
+
 struct PlanProcessRequest {
   std::filesystem::path lamina;       // the `lamina` program
   std::filesystem::path model;
   std::filesystem::path out_dir;
   std::vector<std::string> flags;     // from plan_args_from_settings, plus machine/materials
   double timeout_s = 3600;
+  PlanLimits limits;
 };
 
 struct PlanProcessError {

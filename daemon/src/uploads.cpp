@@ -4,6 +4,7 @@
 #include <array>
 #include <fstream>
 #include <optional>
+#include <stdexcept>
 
 #include <fmt/format.h>
 
@@ -20,6 +21,17 @@ bool model_extension(const std::string& name) {
   std::string ext = name.substr(dot + 1);
   for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   return ext == "stl" || ext == "obj" || ext == "3mf";
+}
+
+// 128 bits from the kernel's generator, as hex: the upload's capability.
+std::string random_id() {
+  std::array<unsigned char, 16> bytes{};
+  std::ifstream urandom("/dev/urandom", std::ios::binary);
+  urandom.read(reinterpret_cast<char*>(bytes.data()), bytes.size());
+  if (!urandom) throw std::runtime_error("cannot read /dev/urandom");
+  std::string id = "u";
+  for (unsigned char b : bytes) id += fmt::format("{:02x}", b);
+  return id;
 }
 
 }  // namespace
@@ -65,7 +77,8 @@ Uploads::Uploads(fs::path dir, UploadLimits limits) : dir_(std::move(dir)), limi
   fs::create_directories(dir_, ec);
 }
 
-std::expected<std::string, RpcError> Uploads::begin(const std::string& file_name, std::uint64_t size_bytes) {
+std::expected<std::string, RpcError> Uploads::begin(const std::string& file_name, std::uint64_t size_bytes,
+                                                    Clock::time_point now) {
   const bool control_char = std::any_of(file_name.begin(), file_name.end(),
                                         [](char c) { return static_cast<unsigned char>(c) < 0x20 || c == 0x7F; });
   if (file_name.empty() || file_name.size() > 200 || file_name.find('/') != std::string::npos || file_name[0] == '.' ||
@@ -75,25 +88,52 @@ std::expected<std::string, RpcError> Uploads::begin(const std::string& file_name
   if (size_bytes == 0 || size_bytes > limits_.max_file_bytes)
     return std::unexpected(invalid(fmt::format("params.size: 1 … {} bytes", limits_.max_file_bytes)));
   std::lock_guard lock(mutex_);
+  expire(now);
   if (open_.size() >= limits_.max_open)
-    return std::unexpected(RpcError{rpc_code::invalid_state, fmt::format("{} uploads are unfinished already", open_.size()), nullptr});
-  const std::string id = fmt::format("u{}", next_++);
-  Upload u{dir_ / (id + "-" + file_name), size_bytes, 0};
+    return std::unexpected(RpcError{rpc_code::invalid_state,
+                                    fmt::format("{} uploads are unfinished already (each is dropped after {} s without "
+                                                "a chunk, or by upload.cancel)",
+                                                open_.size(), limits_.idle_s),
+                                    nullptr});
+  const std::string id = random_id();
+  Upload u{dir_ / (id + "-" + file_name), size_bytes, 0, now};
   std::ofstream create(u.path, std::ios::binary | std::ios::trunc);
   if (!create) return std::unexpected(RpcError{rpc_code::storage_error, fmt::format("cannot create {}", u.path.string()), nullptr});
   open_[id] = u;
   return id;
 }
 
-std::expected<std::uint64_t, RpcError> Uploads::chunk(const std::string& id, std::uint64_t offset, std::string_view base64) {
+void Uploads::expire(Clock::time_point now) {
+  const auto idle = std::chrono::duration<double>(limits_.idle_s);
+  for (auto it = open_.begin(); it != open_.end();) {
+    if (now - it->second.last_activity <= idle) {
+      ++it;
+      continue;
+    }
+    std::error_code ec;
+    fs::remove(it->second.path, ec);
+    it = open_.erase(it);
+  }
+}
+
+std::expected<Uploads::Upload*, RpcError> Uploads::find(const std::string& id, Clock::time_point now) {
+  expire(now);
+  auto it = open_.find(id);
+  // The same answer for an id that never was, expired or was taken: the id is all a client has.
+  if (it == open_.end()) return std::unexpected(invalid(fmt::format("params.upload: no upload {} (unknown, expired or taken)", id)));
+  return &it->second;
+}
+
+std::expected<std::uint64_t, RpcError> Uploads::chunk(const std::string& id, std::uint64_t offset, std::string_view base64,
+                                                      Clock::time_point now) {
   auto data = decode_base64(base64);
   if (!data) return std::unexpected(invalid("params.data: not base64"));
   if (data->empty() || data->size() > limits_.max_chunk_bytes)
     return std::unexpected(invalid(fmt::format("params.data: 1 … {} bytes per chunk", limits_.max_chunk_bytes)));
   std::lock_guard lock(mutex_);
-  auto it = open_.find(id);
-  if (it == open_.end()) return std::unexpected(invalid(fmt::format("params.upload: no upload {}", id)));
-  Upload& u = it->second;
+  auto found = find(id, now);
+  if (!found) return std::unexpected(found.error());
+  Upload& u = **found;
   // In order: the next chunk, or the last one again (a client retrying after a lost reply).
   if (offset > u.received) return std::unexpected(invalid(fmt::format("params.offset: {} leaves a gap (received {})", offset, u.received)));
   if (offset + data->size() > u.size)
@@ -103,18 +143,34 @@ std::expected<std::uint64_t, RpcError> Uploads::chunk(const std::string& id, std
   f.write(data->data(), static_cast<std::streamsize>(data->size()));
   if (!f) return std::unexpected(RpcError{rpc_code::storage_error, fmt::format("writing {} failed", u.path.string()), nullptr});
   u.received = std::max(u.received, offset + data->size());
+  u.last_activity = now;
   return u.received;
 }
 
-std::expected<fs::path, RpcError> Uploads::take(const std::string& id) {
+std::expected<fs::path, RpcError> Uploads::take(const std::string& id, Clock::time_point now) {
+  std::lock_guard lock(mutex_);
+  auto found = find(id, now);
+  if (!found) return std::unexpected(found.error());
+  if ((*found)->received != (*found)->size)
+    return std::unexpected(invalid(fmt::format("params.upload: {} of {} bytes received", (*found)->received, (*found)->size)));
+  fs::path p = (*found)->path;
+  open_.erase(id);
+  return p;
+}
+
+std::expected<void, RpcError> Uploads::cancel(const std::string& id) {
   std::lock_guard lock(mutex_);
   auto it = open_.find(id);
-  if (it == open_.end()) return std::unexpected(invalid(fmt::format("params.upload: no upload {}", id)));
-  if (it->second.received != it->second.size)
-    return std::unexpected(invalid(fmt::format("params.upload: {} of {} bytes received", it->second.received, it->second.size)));
-  fs::path p = it->second.path;
+  if (it == open_.end()) return std::unexpected(invalid(fmt::format("params.upload: no upload {} (unknown, expired or taken)", id)));
+  std::error_code ec;
+  fs::remove(it->second.path, ec);
   open_.erase(it);
-  return p;
+  return {};
+}
+
+std::size_t Uploads::open_count() const {
+  std::lock_guard lock(mutex_);
+  return open_.size();
 }
 
 }  // namespace lamina::daemon

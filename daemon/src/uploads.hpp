@@ -4,6 +4,12 @@
 // their offset (in order; a repeated chunk is accepted again, a gap is refused), and job.submit
 // takes the finished file. Files live in <state_dir>/uploads until a job takes them; the folder
 // is emptied at start-up (an upload does not survive the daemon).
+//
+// An upload's id is its capability: 128 random bits, so no other client can add to, take or
+// cancel it. One that has had no chunk for `idle_s` is dropped (its slot and file freed) —
+// a client that vanished mid-upload must not hold one of the slots until the next restart.
+// Time is an argument (as in sim::Machine), so the expiry is tested without waiting.
+#include <chrono>
 #include <cstdint>
 #include <expected>
 #include <filesystem>
@@ -20,27 +26,37 @@ struct UploadLimits {
   std::uint64_t max_file_bytes = 512ull << 20;   // a 10M-triangle binary STL is 500 MB
   std::size_t max_chunk_bytes = 512 << 10;       // decoded; base64 makes it 683 kB, under the line limit
   std::size_t max_open = 16;                     // unfinished uploads at once
+  double idle_s = 600;                           // no chunk this long: dropped
 };
 
 class Uploads {
  public:
+  using Clock = std::chrono::steady_clock;
   Uploads(std::filesystem::path dir, UploadLimits limits = {});
-  std::expected<std::string, RpcError> begin(const std::string& file_name, std::uint64_t size_bytes);
+  std::expected<std::string, RpcError> begin(const std::string& file_name, std::uint64_t size_bytes,
+                                             Clock::time_point now = Clock::now());
   // Returns the bytes received so far.
-  std::expected<std::uint64_t, RpcError> chunk(const std::string& id, std::uint64_t offset, std::string_view base64);
+  std::expected<std::uint64_t, RpcError> chunk(const std::string& id, std::uint64_t offset, std::string_view base64,
+                                               Clock::time_point now = Clock::now());
   // The complete file (the upload is forgotten; the caller moves or deletes the file).
-  std::expected<std::filesystem::path, RpcError> take(const std::string& id);
+  std::expected<std::filesystem::path, RpcError> take(const std::string& id, Clock::time_point now = Clock::now());
+  // Drops an unfinished (or finished, not yet taken) upload and its file.
+  std::expected<void, RpcError> cancel(const std::string& id);
+  std::size_t open_count() const;
 
  private:
   struct Upload {
     std::filesystem::path path;
     std::uint64_t size = 0, received = 0;
+    Clock::time_point last_activity;
   };
+  void expire(Clock::time_point now);  // under mutex_
+  std::expected<Upload*, RpcError> find(const std::string& id, Clock::time_point now);  // under mutex_
+
   std::filesystem::path dir_;
   UploadLimits limits_;
-  std::mutex mutex_;
+  mutable std::mutex mutex_;
   std::map<std::string, Upload> open_;
-  std::uint64_t next_ = 1;
 };
 
 // RFC 4648 base64 (no line breaks); nullopt on a character outside the alphabet or bad padding.

@@ -59,10 +59,16 @@ baud = 921600
 modbus = "127.0.0.1:{modbus}"
 [planner]
 lamina = "{lamina}"
+memory_limit_mb = {memory_mb}
+[jobs]
+roots = ["{examples}", "{parts}"]
 )",
                        fmt::arg("state", dir.file("state")), fmt::arg("sock", dir.file("lamina.sock")),
                        fmt::arg("extra", extra_server), fmt::arg("cnc", dir.file("cnc")),
-                       fmt::arg("modbus", sim.modbus_port()), fmt::arg("lamina", LAMINA_CLI));
+                       fmt::arg("modbus", sim.modbus_port()), fmt::arg("lamina", LAMINA_CLI),
+                       fmt::arg("examples", LAMINA_EXAMPLES_DIR), fmt::arg("parts", dir.file("parts")),
+                       // A sanitizer build reserves terabytes of shadow address space.
+                       fmt::arg("memory_mb", LAMINA_SANITIZED ? 0 : 4096));
   }
   std::string socket() const { return dir.file("lamina.sock"); }
   std::string log() const { return dir.file("exec.jsonl"); }

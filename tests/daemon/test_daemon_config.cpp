@@ -2,6 +2,7 @@
 // can make in the file is an error naming the key and its line.
 #include "lamina/daemon/daemon_config.hpp"
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <cstdlib>
@@ -81,6 +82,14 @@ void expect_same(const DaemonConfig& a, const DaemonConfig& b) {
   EXPECT_EQ(a.planner.machine_file, b.planner.machine_file);
   EXPECT_EQ(a.planner.materials_file, b.planner.materials_file);
   EXPECT_EQ(a.planner.timeout_s, b.planner.timeout_s);
+  EXPECT_EQ(a.planner.memory_limit_mb, b.planner.memory_limit_mb);
+  EXPECT_EQ(a.planner.cpu_limit_s, b.planner.cpu_limit_s);
+  EXPECT_EQ(a.planner.nice, b.planner.nice);
+  // jobs.roots: [] means <state_dir>/parts, which the parser fills in (JobsRoots below).
+  EXPECT_EQ(a.jobs.max_model_bytes, b.jobs.max_model_bytes);
+  EXPECT_EQ(a.jobs.max_stock_file_bytes, b.jobs.max_stock_file_bytes);
+  EXPECT_EQ(a.jobs.upload_idle_s, b.jobs.upload_idle_s);
+  EXPECT_EQ(a.jobs.max_uploads, b.jobs.max_uploads);
 }
 
 TEST(DaemonConfig, TheDefaultsFileHoldsTheStructDefaults) {
@@ -99,7 +108,8 @@ TEST(DaemonConfig, TheDefaultsFileShowsEveryKey) {
                           "max_request_bytes", "protocol", "port", "baud", "rx_buffer", "status_hz", "enabled",
                           "modbus", "heartbeat_period_s", "pump_ready_timeout_s", "pressure_setpoint_mpa",
                           "abrasive_g_per_min", "hold_limit_s", "jet_restart_s", "lamina", "workers", "machine",
-                          "materials", "timeout_s"})
+                          "materials", "timeout_s", "memory_limit_mb", "cpu_limit_s", "nice", "roots",
+                          "max_model_bytes", "max_stock_file_bytes", "upload_idle_s", "max_uploads"})
     EXPECT_NE(text.find(std::string("\n") + key + " = "), std::string::npos) << key;
 }
 
@@ -115,6 +125,27 @@ TEST(DaemonConfig, TheDemoFilePointsAtTheSimulator) {
   EXPECT_EQ(c->link.tcp, "");
   EXPECT_TRUE(c->cell.enabled);
   EXPECT_EQ(c->cell.modbus, "127.0.0.1:1502");
+}
+
+// The folders a client may name files in: by default the state directory's parts/, never the
+// state directory itself (the database, other jobs' files).
+TEST(DaemonConfig, JobsRoots) {
+  auto d = parse_daemon_config("state_dir = \"/srv/cell\"\n", "/etc/lamina/x.toml");
+  ASSERT_TRUE(d) << d.error().message;
+  EXPECT_EQ(d->jobs.roots, std::vector<std::string>{"/srv/cell/parts"});
+  auto two = parse_daemon_config("[jobs]\nroots = [\"/srv/parts\", \"shared\"]\n", "/etc/lamina/x.toml");
+  ASSERT_TRUE(two) << two.error().message;
+  EXPECT_EQ(two->jobs.roots, (std::vector<std::string>{"/srv/parts", "/etc/lamina/shared"}));
+  for (const char* bad : {"\"/var/lib/lamina\"", "\"/var/lib\"", "\"/\"", "\"/var/lib/lamina/jobs\"",
+                          "\"/var/lib/lamina/uploads/x\""}) {
+    const std::string e = error_of(fmt::format("[jobs]\nroots = [{}]\n", bad));
+    EXPECT_NE(e.find("test.toml:2: [jobs] roots:"), std::string::npos) << e;
+    EXPECT_NE(e.find("state directory"), std::string::npos) << e;
+  }
+  EXPECT_NE(error_of("[jobs]\nroots = \"/srv/parts\"\n").find("expected a list of folders"), std::string::npos);
+  EXPECT_NE(error_of("[jobs]\nroots = [\"\"]\n").find("non-empty"), std::string::npos);
+  EXPECT_NE(error_of("[planner]\nmemory_limit_mb = 100\n").find("at least 256"), std::string::npos);
+  EXPECT_NE(error_of("[planner]\nnice = 20\n").find("[planner] nice: 20 is out of range [0, 19]"), std::string::npos);
 }
 
 TEST(DaemonConfig, AnEmptyFileKeepsTheDefaults) {

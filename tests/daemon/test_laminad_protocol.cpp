@@ -78,6 +78,50 @@ TEST(LaminadProtocol, EveryBadRequestGetsItsErrorAndTheDaemonKeepsServing) {
   EXPECT_TRUE(daemon.running());
 }
 
+// Issue 16, item 9: a client named /etc/shadow and read its first bytes in job.error. Files
+// outside [jobs] roots are refused at submit, in the answer and in no job; stock files too.
+TEST(LaminadProtocol, ASubmitReadsNoFileOutsideTheRoots) {
+  Cell cell;
+  Laminad daemon(cell.config(), cell.dir.file(""));
+  RpcClient c = connect(cell.socket());
+  std::ofstream(cell.dir.file("secret.stl")) << "solid TOP-SECRET-BYTES\n";
+  for (const std::string& model : {std::string("/etc/shadow"), cell.dir.file("secret.stl"),
+                                   std::string(LAMINA_EXAMPLES_DIR) + "/../../etc/shadow"}) {
+    auto r = c.call("job.submit", {{"model", model}});
+    ASSERT_FALSE(r) << model;
+    EXPECT_EQ(r.error().code, -32602);
+    EXPECT_NE(r.error().message.find("outside the folders jobs may read"), std::string::npos) << r.error().message;
+    EXPECT_EQ(r.error().message.find("TOP-SECRET"), std::string::npos);
+  }
+  auto stock = c.call("job.submit", {{"model", std::string(LAMINA_EXAMPLES_DIR) + "/knob.stl"},
+                                     {"settings", {{"stock_file", "/etc/passwd"}}}});
+  ASSERT_FALSE(stock);
+  EXPECT_NE(stock.error().message.find("settings.stock_file: /etc/passwd is outside"), std::string::npos)
+      << stock.error().message;
+  EXPECT_TRUE(call_ok(c, "job.list").empty()) << "no job was made of a refused file";
+  EXPECT_EQ(daemon.log().find("TOP-SECRET"), std::string::npos);
+}
+
+// Issue 16, item 10: a submit with a mistyped setting used the upload up and left its file;
+// now the upload stays for the corrected submit, and a cancelled one is gone with its file.
+TEST(LaminadProtocol, ABadSettingLeavesTheUploadForTheNextTry) {
+  Cell cell;
+  Laminad daemon(cell.config(), cell.dir.file(""));
+  RpcClient c = connect(cell.socket());
+  const Json begun = call_ok(c, "upload.begin", {{"name", "tiny.stl"}, {"size", 3}});
+  const std::string id = begun["upload"];
+  call_ok(c, "upload.chunk", {{"upload", id}, {"offset", 0}, {"data", "Zm9v"}});
+  auto bad = c.call("job.submit", {{"upload", id}, {"settings", {{"strategy", "wavy"}}}});
+  ASSERT_FALSE(bad);
+  EXPECT_NE(bad.error().message.find("strategy"), std::string::npos);
+  EXPECT_TRUE(std::filesystem::exists(cell.dir.file("state/uploads/" + id + "-tiny.stl")));
+  call_ok(c, "upload.cancel", {{"upload", id}});
+  EXPECT_FALSE(std::filesystem::exists(cell.dir.file("state/uploads/" + id + "-tiny.stl")));
+  auto taken = c.call("job.submit", {{"upload", id}});
+  ASSERT_FALSE(taken);
+  EXPECT_NE(taken.error().message.find("no upload"), std::string::npos) << taken.error().message;
+}
+
 TEST(LaminadProtocol, TcpNeedsTheToken) {
   Cell cell;
   const int port = 20000 + (::getpid() % 20000);

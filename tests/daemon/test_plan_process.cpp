@@ -80,3 +80,38 @@ TEST(PlanProcess, APlannerThatIgnoresItsProgressPipeStillPlans) {
 
 }  // namespace
 }  // namespace lamina::daemon
+
+namespace lamina::daemon {
+namespace {
+
+// Issue 16, item 11: `stock_file=/dev/zero` grew a planner to 1.8 GB in 6 s beside a cut. The
+// child runs under its limits (address space, CPU time, nice) and is the OOM killer's first pick.
+TEST(PlanProcess, ThePlannerRunsUnderItsLimits) {
+  TempDir dir;
+  const std::string planner = write_script(dir, R"(
+echo "{\"as_kb\": \"$(ulimit -v)\", \"cpu_s\": \"$(ulimit -t)\", \"nice\": $(nice), \"oom\": $(cat /proc/self/oom_score_adj)}" > "$4/report.json"
+)");
+  PlanProcessRequest r = request_for(dir, planner);
+  r.limits = {512ull << 20, 100, 7};
+  std::atomic<bool> cancel{false};
+  auto report = run_plan_process(r, cancel);
+  ASSERT_TRUE(report) << report.error().message;
+  EXPECT_EQ((*report)["as_kb"], "524288");
+  EXPECT_EQ((*report)["cpu_s"], "100");
+  EXPECT_EQ((*report)["nice"], 7);
+  EXPECT_EQ((*report)["oom"], 1000);
+}
+
+TEST(PlanProcess, APlannerOverItsCpuTimeIsStoppedAndTheMessageSaysWhy) {
+  TempDir dir;
+  const std::string planner = write_script(dir, "while :; do :; done\n");
+  PlanProcessRequest r = request_for(dir, planner);
+  r.limits.cpu_s = 1;
+  std::atomic<bool> cancel{false};
+  auto report = run_plan_process(r, cancel);
+  ASSERT_FALSE(report);
+  EXPECT_NE(report.error().message.find("CPU-time limit is 1 s"), std::string::npos) << report.error().message;
+}
+
+}  // namespace
+}  // namespace lamina::daemon

@@ -1,6 +1,8 @@
 // Uploads in chunks: base64, order, gaps, sizes and names refused with the parameter named.
 #include <gtest/gtest.h>
 
+#include <chrono>
+#include <filesystem>
 #include <fstream>
 
 #include "sim_process.hpp"
@@ -76,6 +78,50 @@ TEST(Uploads, NamesSizesAndDataAreChecked) {
   ASSERT_FALSE(bad);
   EXPECT_NE(bad.error().message.find("params.data"), std::string::npos);
   EXPECT_FALSE(uploads.chunk("u999", 0, "Zm9v"));
+}
+
+// The id is the upload's only key: another client must not be able to guess it (it was "u1",
+// "u2"…, so anyone could append to, or take, another client's upload).
+TEST(Uploads, IdsAreUnguessable) {
+  sim::testing::TempDir dir;
+  Uploads uploads(dir.file("uploads"));
+  auto a = uploads.begin("a.stl", 3), b = uploads.begin("b.stl", 3);
+  ASSERT_TRUE(a && b);
+  EXPECT_NE(*a, *b);
+  EXPECT_EQ(a->size(), 33u) << *a << ": 'u' and 128 bits in hex";
+  EXPECT_EQ(a->find_first_not_of("0123456789abcdef", 1), std::string::npos) << *a;
+  EXPECT_FALSE(uploads.chunk("u1", 0, "Zm9v"));
+  EXPECT_FALSE(uploads.take("u2"));
+}
+
+// 16 unfinished uploads used to block every upload until a restart: an upload with no chunk
+// for idle_s is dropped, with its file; cancel frees a slot at once.
+TEST(Uploads, IdleUploadsExpireAndCancelFreesTheSlot) {
+  sim::testing::TempDir dir;
+  UploadLimits limits;
+  limits.max_open = 2;
+  limits.idle_s = 60;
+  Uploads uploads(dir.file("uploads"), limits);
+  const auto t0 = Uploads::Clock::time_point{} + std::chrono::hours(1);
+  using std::chrono::seconds;
+  auto a = uploads.begin("a.stl", 6, t0), b = uploads.begin("b.stl", 6, t0);
+  ASSERT_TRUE(a && b);
+  EXPECT_FALSE(uploads.begin("c.stl", 6, t0 + seconds(59))) << "both slots in use";
+  ASSERT_TRUE(uploads.chunk(*a, 0, "Zm9v", t0 + seconds(50))) << "a chunk keeps an upload alive";
+  auto c = uploads.begin("c.stl", 6, t0 + seconds(61));
+  ASSERT_TRUE(c) << "b had no chunk for 61 s: " << c.error().message;
+  EXPECT_EQ(uploads.open_count(), 2u);
+  auto gone = uploads.chunk(*b, 0, "Zm9v", t0 + seconds(62));
+  ASSERT_FALSE(gone);
+  EXPECT_NE(gone.error().message.find("expired"), std::string::npos) << gone.error().message;
+  std::size_t files = 0;
+  for (const auto& e : std::filesystem::directory_iterator(dir.file("uploads"))) files += e.is_regular_file();
+  EXPECT_EQ(files, 2u) << "the expired upload's file is deleted";
+
+  ASSERT_TRUE(uploads.cancel(*c));
+  EXPECT_FALSE(uploads.cancel(*c)) << "once";
+  EXPECT_FALSE(uploads.take(*c));
+  EXPECT_TRUE(uploads.begin("d.stl", 6, t0 + seconds(63))) << "the cancelled upload's slot is free";
 }
 
 }  // namespace

@@ -2,10 +2,12 @@
 // laminad's configuration: TOML (/etc/lamina/lamina.toml; config/lamina.toml holds the defaults,
 // config/demo.toml points at the simulator). Validated at start: a wrong type, a value out of
 // range or an unknown key is an error naming the file, the key and (when known) the line.
+#include <cstdint>
 #include <expected>
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace lamina::daemon {
 
@@ -49,6 +51,19 @@ struct PlannerConfig {
   std::string machine_file;                // --machine for lamina plan (empty: its default)
   std::string materials_file;
   double timeout_s = 3600;
+  // The child's limits: a hostile or huge model must not starve a cut on the cell PC.
+  std::uint64_t memory_limit_mb = 4096;    // address space (RLIMIT_AS); 0: none
+  double cpu_limit_s = 0;                  // CPU time of all its threads (RLIMIT_CPU); 0: none (timeout_s still holds)
+  int nice = 10;                           // 0 … 19: below the cut's threads
+};
+
+// Files a client may name (job.submit's model, settings.stock_file) and its uploads.
+struct JobsConfig {
+  std::vector<std::string> roots;          // folders; empty: <state_dir>/parts
+  std::uint64_t max_model_bytes = 512ull << 20;
+  std::uint64_t max_stock_file_bytes = 1 << 20;
+  double upload_idle_s = 600;              // an upload with no chunk this long is dropped
+  std::size_t max_uploads = 16;            // unfinished at once
 };
 
 struct DaemonConfig {
@@ -57,6 +72,7 @@ struct DaemonConfig {
   MachineLinkConfig link;
   CellConfig cell;
   PlannerConfig planner;
+  JobsConfig jobs;
   std::string source;                      // the file read, for messages
 };
 
