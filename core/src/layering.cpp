@@ -53,10 +53,47 @@ std::expected<std::vector<double>, Error> validate(const LayeringParams& p) {
   return t;
 }
 
+// The stock against the model (issue 16, item 11: --stock 1e10 crashed, --stock 0.001 took
+// 2.6 GB): a sheet thicker than the whole part is never needed (dropped, said); a sheet that
+// rounds to no grid line cannot be placed; a stack of more than kMaxLayers layers is no plan.
+constexpr double kMaxLayers = 10'000;
+
+std::expected<std::vector<double>, Error> fit_to_model(const Mesh& mesh, const LayeringParams& p, std::vector<double> t,
+                                                       std::vector<std::string>& warnings) {
+  const double height = mesh.summary.bbox_max_mm.z() - mesh.summary.bbox_min_mm.z();
+  if (!(height > 0.0)) return t;  // a hand-made Mesh without its summary: the estimator measures it
+  if (t.front() > height)
+    return invalid(fmt::format("every stock sheet is thicker than the part: the thinnest is {} mm, the part {:.3f} mm "
+                               "tall along the stacking axis",
+                               t.front(), height));
+  std::vector<double> dropped;
+  while (t.back() > height) {
+    dropped.push_back(t.back());
+    t.pop_back();
+  }
+  if (!dropped.empty()) {
+    std::string list;
+    for (double d : dropped) list += (list.empty() ? "" : ", ") + fmt::format("{}", d);
+    warnings.push_back(fmt::format("stock sheets thicker than the whole part ({:.3f} mm) are not used: {} mm", height, list));
+  }
+  if (t.front() < 0.5 * p.sub_slice_mm)
+    return invalid(fmt::format("stock thickness {} mm is thinner than half the sub-slice spacing ({} mm): no grid line "
+                               "can place it; give a sub-slice of {} mm or less, or leave the sheet out",
+                               t.front(), p.sub_slice_mm, t.front()));
+  if (height / t.front() > kMaxLayers)
+    return invalid(fmt::format("the part ({:.3f} mm) in {} mm sheets would be {:.0f} layers, more than {:.0f}: give "
+                               "thicker stock",
+                               height, t.front(), std::ceil(height / t.front()), kMaxLayers));
+  return t;
+}
+
 }  // namespace
 
 std::expected<Layering, Error> choose_layers(const Mesh& mesh, const LayeringParams& params) {
-  auto thicknesses = validate(params);
+  auto validated = validate(params);
+  if (!validated) return std::unexpected(validated.error());
+  std::vector<std::string> stock_warnings;
+  auto thicknesses = fit_to_model(mesh, params, std::move(*validated), stock_warnings);
   if (!thicknesses) return std::unexpected(thicknesses.error());
   auto created = layering_detail::Estimator::create(mesh, params, *thicknesses);
   if (!created) return std::unexpected(created.error());
@@ -91,6 +128,7 @@ std::expected<Layering, Error> choose_layers(const Mesh& mesh, const LayeringPar
   }
 
   auto& w = out.warnings;
+  w = std::move(stock_warnings);
   if (!mesh.usable()) w.push_back("the mesh has defects that make it unusable as a solid; the layering is approximate");
   for (const auto& s : est.warnings()) w.push_back(s);
   for (double th : t) {

@@ -239,6 +239,22 @@ TEST(CliPlan, StockFileErrorsNameTheKeyAndLine) {
   EXPECT_TRUE(has_text(r, "cannot read stock file " + toml.string())) << r.out;
 }
 
+// Issue 16, item 11: `--stock 1e10` crashed the planner (SIGSEGV), `--stock 0.001` took 2.6 GB,
+// `--stock-file /dev/zero` grew without end. Each is a clear error (exit 1) before any work.
+TEST(CliPlan, StockTheModelCannotUseIsAClearErrorNotACrash) {
+  TempDir out("plan-absurd-stock");
+  const std::string base = "plan " + quoted(kKnob) + " --out " + quoted(out.path) + " ";
+  for (const auto& [arg, fragment] : std::vector<std::pair<std::string, std::string>>{
+           {"--stock 1e10", "every stock sheet is thicker than the part"},
+           {"--stock 0.001", "thinner than half the sub-slice spacing"},
+           {"--stock-file /dev/zero", "stock file /dev/zero is not a regular file"}}) {
+    const CliRun r = lamina(base + arg);
+    EXPECT_EQ(r.exit_code, 1) << arg << ":\n" << r.out;
+    EXPECT_TRUE(has_text(r, fragment)) << arg << ": expected " << fragment << " in:\n" << r.out;
+  }
+  EXPECT_FALSE(fs::exists(out.path / "report.json"));
+}
+
 TEST(CliPlan, UnwritableOutputFolderIsAClearError) {
   const fs::path file = temp_file("not-a-folder");
   std::ofstream(file) << "x";

@@ -121,3 +121,38 @@ TEST(LayeringParams, ThicknessOrderAndDuplicatesDoNotMatter) {
 
 }  // namespace
 }  // namespace lamina
+
+namespace lamina {
+namespace {
+
+// Issue 16, item 11: `--stock 1e10` crashed the planner, `--stock 0.001` took 2.6 GB in 90 s.
+// The stock is checked against the model before anything is sliced.
+TEST(LayeringParams, StockIsCheckedAgainstTheModel) {
+  auto p = stock_params();
+  p.thicknesses_mm = {1e10};
+  expect_invalid(p, "every stock sheet is thicker than the part: the thinnest is 10000000000 mm, the part 10.000 mm");
+  p.thicknesses_mm = {0.001};
+  expect_invalid(p, "stock thickness 0.001 mm is thinner than half the sub-slice spacing (0.5 mm)");
+  p.thicknesses_mm = {0.001};
+  p.sub_slice_mm = 0.001;
+  const Mesh tall = build(mesh_test::box({0, 0, 0}, {20, 20, 20}));
+  auto r = choose_layers(tall, p);
+  ASSERT_FALSE(r);
+  EXPECT_NE(r.error().message.find("the part (20.000 mm) in 0.001 mm sheets would be 20000 layers, more than 10000"),
+            std::string::npos)
+      << r.error().message;
+}
+
+TEST(LayeringParams, SheetsThickerThanThePartAreLeftOutAndSaid) {
+  auto p = stock_params();
+  p.thicknesses_mm = {2.5, 5, 1e10, 20};
+  auto r = choose_layers(cube(), p);
+  ASSERT_TRUE(r) << r.error().message;
+  for (const LayerSpan& l : r->layers) EXPECT_LE(l.thickness_mm, 5.0);
+  bool said = false;
+  for (const auto& w : r->warnings) said = said || w.find("not used: 10000000000, 20 mm") != std::string::npos;
+  EXPECT_TRUE(said) << ::testing::PrintToString(r->warnings);
+}
+
+}  // namespace
+}  // namespace lamina
