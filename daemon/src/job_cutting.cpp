@@ -48,26 +48,35 @@ bool still(drivers::ControllerState s) {
 }  // namespace
 
 // Under mutex_. Joins the previous cutting thread (it has left finish_cut: cutting_ is false).
-void JobManager::start_cut(JobRecord& job, CutStart how) {
+// Nothing moves unless the database has taken the job's `cutting` first: a cut it does not know
+// of would be cut again after a crash.
+std::expected<void, RpcError> JobManager::start_cut(JobRecord& job, CutStart how) {
   if (cutter_.joinable()) cutter_.join();
   SheetRecord* sheet = sheet_of(job, job.current_sheet);
-  if (!sheet) return;
+  if (!sheet) return std::unexpected(RpcError{rpc_code::internal_error, fmt::format("job {} has no sheet {}", job.id, job.current_sheet), nullptr});
   std::vector<std::string> program = read_program(sheet->program_path);
   if (program.empty()) {
-    (void)set_state(job, JobState::interrupted, fmt::format("{}: no program lines", sheet->program_path));
-    return;
+    const std::string why = fmt::format("{}: no program lines", sheet->program_path);
+    (void)set_state(job, JobState::interrupted, why);
+    return std::unexpected(RpcError{rpc_code::invalid_state, why, nullptr});
   }
+  const SheetState sheet_before = sheet->state;
+  sheet->state = SheetState::cutting;
+  if (auto written = set_state(job, JobState::cutting); !written) {
+    if (SheetRecord* s = sheet_of(job, job.current_sheet)) s->state = sheet_before;  // reload may have done it
+    return std::unexpected(written.error());
+  }
+  sheet = sheet_of(job, job.current_sheet);
   if (how != CutStart::resume_stopped || !cut_)
     cut_ = std::make_unique<drivers::CutJob>(machine_.link(), machine_.cell(), program, machine_.cut_settings());
   if (how == CutStart::resume_stopped && cut_->report().state != drivers::CutState::stopped) how = CutStart::fresh;
-  sheet->state = SheetState::cutting;
   cutting_ = true;
   pause_ = PauseKind::none;
-  (void)set_state(job, JobState::cutting);
   cut_->on_progress([this, id = job.id, index = sheet->index](const drivers::CutReport& r) { save_progress(id, index, r); });
   cutter_ = std::thread([this, id = job.id, index = sheet->index, how, program = std::move(program)]() mutable {
     cut_sheet(id, index, how, std::move(program), std::nullopt);
   });
+  return {};
 }
 
 void JobManager::cut_sheet(std::string job_id, int sheet_index, CutStart how, std::vector<std::string> program,
@@ -160,7 +169,12 @@ void JobManager::save_progress(const std::string& job_id, int sheet_index, const
       job_copy = *job;
     }
   }
-  if (auto s = store_.update_sheet(job_id, copy); !s) log()->error("job {}: progress not saved: {}", job_id, s.error().message);
+  if (auto s = store_.update_sheet(job_id, copy); !s) {
+    std::lock_guard lock(mutex_);
+    store_failed(s.error().message);  // stops the cut
+    if (JobRecord* job = find(job_id)) reload(*job);
+    return;
+  }
   if (announce_now && notify_) {
     nlohmann::json j = to_json(job_copy);
     j["progress"] = {{"sheet", sheet_index}, {"lines_accepted", r.lines_accepted}, {"lines", r.lines_total}};

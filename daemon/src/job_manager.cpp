@@ -110,28 +110,60 @@ void JobManager::shutdown(const std::string& why) {
 
 // ---------------------------------------------------------------------------- state machine
 
+// Disk first, memory after: a state the database did not take is not taken at all (the job is
+// read back as the database has it), so what clients are told never runs ahead of a restart.
 std::expected<void, RpcError> JobManager::set_state(JobRecord& job, JobState to, const std::string& why) {
+  if (auto refused = store_refusal()) {
+    reload(job);
+    return std::unexpected(*refused);
+  }
   if (!allowed(job.state, to))
     return std::unexpected(error(rpc_code::invalid_state, fmt::format("job {} is {}: it cannot become {}", job.id,
                                                                       to_string(job.state), to_string(to))));
   const JobState from = job.state;
-  job.state = to;
-  job.updated_unix_ms = now_unix_ms();
-  if (!why.empty() || to == JobState::cutting || to == JobState::completed) job.error = why;
-  persist(job);
+  JobRecord next = job;
+  next.state = to;
+  next.updated_unix_ms = now_unix_ms();
+  if (!why.empty() || to == JobState::cutting || to == JobState::completed) next.error = why;
+  if (auto r = store_.update_job(next); !r) {
+    store_failed(r.error().message);
+    reload(job);
+    return std::unexpected(*store_refusal());
+  }
+  job = std::move(next);
   event(job, "state", {{"from", to_string(from)}, {"to", to_string(to)}, {"reason", why}});
   log()->info("job {}: {} → {}{}", job.id, to_string(from), to_string(to), why.empty() ? "" : " (" + why + ")");
   announce(job);
   return {};
 }
 
-void JobManager::persist(const JobRecord& job) {
-  if (auto r = store_.update_job(job); !r) log()->error("job {}: not saved: {}", job.id, r.error().message);
+void JobManager::event(const JobRecord& job, const std::string& kind, nlohmann::json data) {
+  if (auto r = store_.add_event(JobEvent{job.id, now_unix_ms(), kind, std::move(data)}); !r) store_failed(r.error().message);
 }
 
-void JobManager::event(const JobRecord& job, const std::string& kind, nlohmann::json data) {
-  if (auto r = store_.add_event(JobEvent{job.id, now_unix_ms(), kind, std::move(data)}); !r)
-    log()->error("job {}: event not saved: {}", job.id, r.error().message);
+// Issue 16, item 6: with the state directory full the cut went on, progress was only logged,
+// and a restart then re-cut finished contours. A write that fails stops the cut (jet off, feed
+// hold, its resume point kept by the CNC's count) and every request that would write is
+// refused with -32014 until laminad is restarted with room on the disk. Hold and abort still work.
+void JobManager::store_failed(const std::string& message) {
+  if (store_fault_) return;
+  store_fault_ = message;
+  log()->critical("the job store cannot be written: {}. The cut is stopped; free the disk and restart laminad", message);
+  if (cutting_ && cut_) cut_->abort(fmt::format("the job store cannot be written ({})", message));
+  if (notify_) notify_("notify_machine_status", {{"store", {{"ok", false}, {"error", message}}}});
+}
+
+std::optional<RpcError> JobManager::store_refusal() const {
+  if (!store_fault_) return std::nullopt;
+  return error(rpc_code::storage_error,
+               fmt::format("the job store cannot be written ({}): nothing was changed; free space under {} and "
+                           "restart laminad",
+                           *store_fault_, config_.state_dir.string()));
+}
+
+void JobManager::reload(JobRecord& job) {
+  auto disk = store_.get_job(job.id);
+  if (disk && *disk) job = std::move(**disk);
 }
 
 void JobManager::announce(const JobRecord& job) {
@@ -204,6 +236,10 @@ std::expected<JobRecord, RpcError> JobManager::submit(SubmitRequest r) {
   };
   auto args = plan_args_from_settings(r.settings);
   if (!args) return fail(error(rpc_code::invalid_params, args.error()), nullptr);
+  {
+    std::lock_guard lock(mutex_);
+    if (auto refused = store_refusal()) return fail(*refused, nullptr);
+  }
 
   JobRecord job;
   job.id = new_job_id();
@@ -220,7 +256,10 @@ std::expected<JobRecord, RpcError> JobManager::submit(SubmitRequest r) {
 
   std::lock_guard lock(mutex_);
   if (stopping_) return fail(error(rpc_code::shutting_down, "the daemon is stopping"), &job);
-  if (auto s = store_.insert_job(job); !s) return fail(error(rpc_code::storage_error, s.error().message), &job);
+  if (auto s = store_.insert_job(job); !s) {
+    store_failed(s.error().message);
+    return fail(*store_refusal(), &job);
+  }
   event(job, "state", {{"from", nullptr}, {"to", "queued"}, {"reason", "submitted"},
                        {"source", r.move_into_job ? nlohmann::json("upload") : nlohmann::json(r.model_path)}});
   log()->info("job {}: queued ({}, from {})", job.id, job.model_path, r.move_into_job ? "an upload" : r.model_path);
@@ -255,6 +294,7 @@ std::expected<JobRecord, RpcError> JobManager::cancel(const std::string& id) {
     std::lock_guard lock(mutex_);
     JobRecord* job = find(id);
     if (!job) return std::unexpected(error(rpc_code::job_not_found, fmt::format("no job {}", id)));
+    if (auto refused = store_refusal()) return std::unexpected(*refused);  // machine.abort stops a cut all the same
     if (is_terminal(job->state))
       return std::unexpected(error(rpc_code::invalid_state, fmt::format("job {} is already {}", id, to_string(job->state))));
     if (job->state == JobState::planning) {
@@ -299,7 +339,7 @@ std::expected<JobRecord, RpcError> JobManager::confirm_sheet(const std::string& 
   if (sheet != job->current_sheet)
     return std::unexpected(error(rpc_code::invalid_params,
                                  fmt::format("sheet {}: job {} waits for sheet {}", sheet, id, job->current_sheet)));
-  start_cut(*job, CutStart::fresh);
+  if (auto started = start_cut(*job, CutStart::fresh); !started) return std::unexpected(started.error());
   return *job;
 }
 
@@ -307,6 +347,7 @@ std::expected<JobRecord, RpcError> JobManager::resume(const std::string& id) {
   std::lock_guard lock(mutex_);
   JobRecord* job = find(id);
   if (!job) return std::unexpected(error(rpc_code::job_not_found, fmt::format("no job {}", id)));
+  if (auto refused = store_refusal()) return std::unexpected(*refused);
   if (job->state == JobState::paused && pause_ == PauseKind::hold && cutting_) {
     drivers::CutJob* cut = cut_.get();
     cut->continue_motion();  // jet on again first, then the cycle start (line and PLC): CutJob's hold watch
@@ -316,23 +357,26 @@ std::expected<JobRecord, RpcError> JobManager::resume(const std::string& id) {
   }
   if (job->state == JobState::paused) {
     if (cutting_) return std::unexpected(error(rpc_code::machine_busy, "the cut is still stopping; try again"));
-    start_cut(*job, CutStart::resume_stopped);
+    if (auto started = start_cut(*job, CutStart::resume_stopped); !started) return std::unexpected(started.error());
     return *job;
   }
   if (job->state == JobState::interrupted) {
     if (!machine_job_.empty() && machine_job_ != id)
       return std::unexpected(error(rpc_code::machine_busy, fmt::format("the machine is with job {}", machine_job_)));
+    if (auto started = start_cut(*job, CutStart::resume_interrupted); !started) return std::unexpected(started.error());
     machine_job_ = id;
-    start_cut(*job, CutStart::resume_interrupted);
     return *job;
   }
   return std::unexpected(error(rpc_code::invalid_state,
                                fmt::format("job {} is {}: only paused or interrupted jobs resume", id, to_string(job->state))));
 }
 
-nlohmann::json JobManager::machine_status() const {
+nlohmann::json JobManager::machine_status() {
   nlohmann::json status = machine_.status();
+  const auto file = store_.check_file();  // a database deleted while nothing writes is noticed here
   std::lock_guard lock(mutex_);
+  if (!file) store_failed(file.error().message);
+  status["store"] = {{"ok", !store_fault_}, {"error", store_fault_ ? nlohmann::json(*store_fault_) : nlohmann::json(nullptr)}};
   status["job"] = machine_job_.empty() ? nlohmann::json(nullptr) : nlohmann::json(machine_job_);
   if (const JobRecord* job = find(machine_job_)) {
     status["job_state"] = to_string(job->state);

@@ -56,7 +56,7 @@ class JobManager {
   std::expected<JobRecord, RpcError> confirm_sheet(const std::string& id, int sheet);
   std::expected<JobRecord, RpcError> resume(const std::string& id);  // paused or interrupted
 
-  nlohmann::json machine_status() const;
+  nlohmann::json machine_status();  // checks the database file too
   std::expected<nlohmann::json, RpcError> hold();
   std::expected<nlohmann::json, RpcError> resume_motion();
   std::expected<nlohmann::json, RpcError> abort(const std::string& why);
@@ -69,13 +69,15 @@ class JobManager {
 
   // --- under mutex_ ---
   std::expected<void, RpcError> set_state(JobRecord& job, JobState to, const std::string& why = {});
-  void persist(const JobRecord& job);
+  void store_failed(const std::string& message);     // latches the fault, stops the cut
+  std::optional<RpcError> store_refusal() const;      // -32014 while the store has failed
+  void reload(JobRecord& job);                        // memory as the database has it
   void event(const JobRecord& job, const std::string& kind, nlohmann::json data);
   void announce(const JobRecord& job);
   void assign_machine();              // the oldest planned job gets the machine when it is free
   JobRecord* find(const std::string& id);
   const JobRecord* find(const std::string& id) const;
-  void start_cut(JobRecord& job, CutStart how);
+  std::expected<void, RpcError> start_cut(JobRecord& job, CutStart how);
   std::expected<void, RpcError> stage_inputs(JobRecord& job, const SubmitRequest& r) const;  // no lock needed
 
   // --- threads ---
@@ -100,6 +102,7 @@ class JobManager {
   std::map<std::string, std::shared_ptr<std::atomic<bool>>> plan_cancel_;
   std::vector<std::thread> planners_;
   bool stopping_ = false;
+  std::optional<std::string> store_fault_;  // a store write failed: see store_failed
 
   std::string machine_job_;           // the job that owns the machine (empty: free)
   std::string cancel_after_stop_;     // cancel this job when its cut has stopped

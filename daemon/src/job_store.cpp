@@ -265,6 +265,13 @@ std::expected<std::unique_ptr<JobStore>, StoreError> JobStore::open(const std::f
   return std::unique_ptr<JobStore>(new JobStore(std::move(impl)));
 }
 
+std::expected<void, StoreError> JobStore::check_file() const {
+  std::lock_guard lock(impl_->mutex);
+  if (auto same = impl_->db.still_the_file(); !same)
+    return Fail(StoreError{fmt::format("{}: {}", impl_->db.path().string(), same.error().message)});
+  return {};
+}
+
 std::expected<void, StoreError> JobStore::insert_job(const JobRecord& job) {
   std::lock_guard lock(impl_->mutex);
   Connection& db = impl_->db;

@@ -1,5 +1,10 @@
 #include "sqlite_connection.hpp"
 
+#include <sys/stat.h>
+
+#include <cerrno>
+#include <cstring>
+
 namespace lamina::daemon::sqlite {
 
 Connection::~Connection() {
@@ -14,6 +19,20 @@ std::expected<void, StoreError> Connection::open(int busy_timeout_ms) {
     return Fail(StoreError{db_ != nullptr ? sqlite3_errmsg(db_) : "out of memory"});
   // Another process (the CLI, a backup) may hold the lock for a moment.
   sqlite3_busy_timeout(db_, busy_timeout_ms);
+  struct stat st {};
+  if (::stat(path_.c_str(), &st) != 0) return Fail(StoreError{fmt::format("stat: {}", std::strerror(errno))});
+  device_ = st.st_dev;
+  inode_ = st.st_ino;
+  return {};
+}
+
+std::expected<void, StoreError> Connection::still_the_file() const {
+  struct stat st {};
+  if (::stat(path_.c_str(), &st) != 0)
+    return Fail(StoreError{fmt::format("the database file is gone ({}): it was deleted under the running daemon",
+                                       std::strerror(errno))});
+  if (st.st_dev != device_ || st.st_ino != inode_)
+    return Fail(StoreError{"the database file was replaced under the running daemon (another file has its name)"});
   return {};
 }
 

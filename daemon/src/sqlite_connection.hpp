@@ -100,6 +100,9 @@ class Connection {
 
   // Opens (creating) the file; errors without the file name (the caller adds it).
   std::expected<void, StoreError> open(int busy_timeout_ms);
+  // The file at path() is still the one opened. SQLite writes on into a deleted (or renamed,
+  // or replaced) file without a word, and a restart then finds none of it: every write checks.
+  std::expected<void, StoreError> still_the_file() const;
   sqlite3* handle() const { return db_; }
   const std::filesystem::path& path() const { return path_; }
 
@@ -120,6 +123,8 @@ class Connection {
     auto fail = [&](const StoreError& e) {
       return Result(Fail(StoreError{fmt::format("{}: {}: {}", path_.string(), context, e.message)}));
     };
+    if (write)
+      if (auto same = still_the_file(); !same) return fail(same.error());
     // Reads take a deferred BEGIN: a consistent snapshot without taking the write lock.
     if (auto begun = run(write ? "BEGIN IMMEDIATE" : "BEGIN", "begin a transaction"); !begun)
       return fail(begun.error());
@@ -141,6 +146,7 @@ class Connection {
  private:
   std::filesystem::path path_;
   sqlite3* db_ = nullptr;
+  std::uint64_t device_ = 0, inode_ = 0;
   std::unordered_map<std::string_view, sqlite3_stmt*> cache_;  // keyed by the SQL literal
 };
 

@@ -5,6 +5,7 @@
 #include <spawn.h>
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
@@ -14,6 +15,7 @@
 #include <vector>
 
 #include <fmt/format.h>
+#include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
 #include "lamina/daemon/rpc_client.hpp"
@@ -203,6 +205,31 @@ inline std::vector<LogBlock> executed(const std::string& log) {
   for (const auto& r : sim::testing::executed_blocks(sim::testing::read_log(log)))
     out.push_back({r["line"], r.value("completed", true)});
   return out;
+}
+
+// The first run is the program's prefix; the resumed run starts at the contour that was being
+// cut when the daemon died: no finished contour runs twice, nothing is skipped.
+inline void expect_resumed_at_the_cut_short_contour(const std::vector<std::string>& lines, const std::vector<LogBlock>& ran_before,
+                                             const std::vector<LogBlock>& log) {
+  std::size_t done = 0;
+  while (done < ran_before.size() && ran_before[done].line == lines[done]) ++done;
+  ASSERT_EQ(done, ran_before.size()) << "the first run is the program in order";
+  std::size_t finished = 0;  // lines that completed in the first run
+  for (std::size_t i = 0; i < ran_before.size(); ++i)
+    if (ran_before[i].completed) finished = i + 1;
+  std::size_t contour_start = 0;
+  for (std::size_t k = 0; k <= std::min(finished, lines.size() - 1); ++k)
+    if (lines[k].rfind("(CONTOUR ", 0) == 0) contour_start = k;
+  std::size_t resumed_at = log.size();
+  for (std::size_t i = ran_before.size(); i < log.size(); ++i)
+    if (log[i].line == lines[contour_start]) {
+      resumed_at = i;
+      break;
+    }
+  ASSERT_LT(resumed_at, log.size()) << "the resumed run starts at contour line " << contour_start + 1;
+  ASSERT_EQ(log.size() - resumed_at, lines.size() - contour_start);
+  for (std::size_t i = 0; i < lines.size() - contour_start; ++i)
+    ASSERT_EQ(log[resumed_at + i].line, lines[contour_start + i]) << "resumed block " << i + 1;
 }
 
 }  // namespace lamina::daemon::testing

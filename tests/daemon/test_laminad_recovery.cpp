@@ -25,31 +25,6 @@ std::string start_cutting(RpcClient& c, Cell& cell, std::size_t blocks_before) {
   return id;
 }
 
-// The first run is the program's prefix; the resumed run starts at the contour that was being
-// cut when the daemon died: no finished contour runs twice, nothing is skipped.
-void expect_resumed_at_the_cut_short_contour(const std::vector<std::string>& lines, const std::vector<LogBlock>& ran_before,
-                                             const std::vector<LogBlock>& log) {
-  std::size_t done = 0;
-  while (done < ran_before.size() && ran_before[done].line == lines[done]) ++done;
-  ASSERT_EQ(done, ran_before.size()) << "the first run is the program in order";
-  std::size_t finished = 0;  // lines that completed in the first run
-  for (std::size_t i = 0; i < ran_before.size(); ++i)
-    if (ran_before[i].completed) finished = i + 1;
-  std::size_t contour_start = 0;
-  for (std::size_t k = 0; k <= std::min(finished, lines.size() - 1); ++k)
-    if (lines[k].rfind("(CONTOUR ", 0) == 0) contour_start = k;
-  std::size_t resumed_at = log.size();
-  for (std::size_t i = ran_before.size(); i < log.size(); ++i)
-    if (log[i].line == lines[contour_start]) {
-      resumed_at = i;
-      break;
-    }
-  ASSERT_LT(resumed_at, log.size()) << "the resumed run starts at contour line " << contour_start + 1;
-  ASSERT_EQ(log.size() - resumed_at, lines.size() - contour_start);
-  for (std::size_t i = 0; i < lines.size() - contour_start; ++i)
-    ASSERT_EQ(log[resumed_at + i].line, lines[contour_start + i]) << "resumed block " << i + 1;
-}
-
 // What the board does when a host opens its port (lamina-sim --on-open): greets, or reboots as
 // a classic Grbl does on DTR. The daemon opens the port only to cut, so on a resetting board
 // the resume's open resets the machine again before the resumed program: it must still work.

@@ -39,6 +39,9 @@ class JobStore {
   // Returns the ids changed.
   std::expected<std::vector<std::string>, StoreError> recover_after_restart();
 
+  // The database file is still there and the one opened (every write checks this too).
+  std::expected<void, StoreError> check_file() const;
+
  private:
   struct Impl;
   explicit JobStore(std::unique_ptr<Impl> impl);
