@@ -118,6 +118,11 @@ int run(const fs::path& config_path, bool check_only) {
   rs.tcp_port = config->server.tcp_port;
   rs.token = config->server.token;
   rs.max_request_bytes = config->server.max_request_bytes;
+  rs.max_clients = config->server.max_clients;
+  rs.idle_timeout_s = config->server.idle_timeout_s;
+  rs.pre_auth_timeout_s = config->server.pre_auth_timeout_s;
+  // The operator's stop buttons jump every queue (and server.subscribe touches its own client).
+  rs.inline_methods = {"machine.hold", "machine.abort", "server.subscribe", "server.info"};
 
   // Socket activation: laminad.socket hands over the Unix listener; TCP (if any) is ours to open.
   std::vector<int> activated;

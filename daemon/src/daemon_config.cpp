@@ -172,8 +172,10 @@ class Section {
 
 constexpr std::array kRootKeys{"state_dir"sv};
 constexpr std::array kSections{"server"sv, "link"sv, "cell"sv, "planner"sv, "jobs"sv};
-constexpr std::array kServerKeys{"socket"sv, "socket_mode"sv, "socket_group"sv, "tcp"sv, "token"sv, "token_file"sv,
-                                 "max_request_bytes"sv};
+constexpr std::array kServerKeys{"socket"sv,        "socket_mode"sv,       "socket_group"sv,
+                                 "tcp"sv,           "token"sv,             "token_file"sv,
+                                 "max_request_bytes"sv, "max_clients"sv,   "idle_timeout_s"sv,
+                                 "pre_auth_timeout_s"sv};
 constexpr std::array kLinkKeys{"protocol"sv, "port"sv, "tcp"sv, "baud"sv, "rx_buffer"sv, "status_hz"sv, "stall_margin_s"sv};
 constexpr std::array kCellKeys{"enabled"sv, "modbus"sv, "modbus_unit"sv, "modbus_timeout_s"sv,
                                "modbus_reconnects"sv, "heartbeat_period_s"sv, "pump_ready_timeout_s"sv,
@@ -238,6 +240,9 @@ void read_server(Section s, ServerConfig& c) {
   // (Not said when the token file failed: that message is the one that helps.)
   if (read_token(s, c) && c.tcp_host && c.token.empty()) s.fail("tcp", "TCP needs a token (set token or token_file)");
   s.integer("max_request_bytes", c.max_request_bytes, 1024, std::int64_t{1} << 30);
+  s.integer("max_clients", c.max_clients, 1, 4096);
+  s.number("idle_timeout_s", c.idle_timeout_s, {0, 7 * 24 * 3600});
+  s.number("pre_auth_timeout_s", c.pre_auth_timeout_s, {0.1, 600});
 }
 
 void read_link(Section s, MachineLinkConfig& c) {

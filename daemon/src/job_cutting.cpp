@@ -68,7 +68,7 @@ std::expected<void, RpcError> JobManager::start_cut(JobRecord& job, CutStart how
   }
   sheet = sheet_of(job, job.current_sheet);
   if (how != CutStart::resume_stopped || !cut_)
-    cut_ = std::make_unique<drivers::CutJob>(machine_.link(), machine_.cell(), program, machine_.cut_settings());
+    cut_ = std::make_shared<drivers::CutJob>(machine_.link(), machine_.cell(), program, machine_.cut_settings());
   if (how == CutStart::resume_stopped && cut_->report().state != drivers::CutState::stopped) how = CutStart::fresh;
   cutting_ = true;
   pause_ = PauseKind::none;

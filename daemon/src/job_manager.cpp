@@ -87,13 +87,13 @@ std::expected<void, RpcError> JobManager::start() {
 }
 
 void JobManager::shutdown(const std::string& why) {
-  drivers::CutJob* cut = nullptr;
+  std::shared_ptr<drivers::CutJob> cut;
   {
     std::lock_guard lock(mutex_);
     if (stopping_ && planners_.empty() && !cutter_.joinable()) return;
     stopping_ = true;
     for (auto& [id, flag] : plan_cancel_) flag->store(true);
-    if (cutting_) cut = cut_.get();
+    if (cutting_) cut = cut_;
   }
   plan_wake_.notify_all();
   if (cut) cut->abort(why);  // the cutter thread marks its job interrupted (stopping_)
@@ -288,7 +288,7 @@ std::expected<JobRecord, RpcError> JobManager::get(const std::string& id) const 
 }
 
 std::expected<JobRecord, RpcError> JobManager::cancel(const std::string& id) {
-  drivers::CutJob* cut = nullptr;
+  std::shared_ptr<drivers::CutJob> cut;
   JobRecord copy;
   {
     std::lock_guard lock(mutex_);
@@ -303,7 +303,7 @@ std::expected<JobRecord, RpcError> JobManager::cancel(const std::string& id) {
     }
     if (id == machine_job_ && cutting_) {
       cancel_after_stop_ = id;
-      cut = cut_.get();
+      cut = cut_;
       copy = *job;
     } else {
       std::erase(plan_queue_, id);
@@ -349,7 +349,7 @@ std::expected<JobRecord, RpcError> JobManager::resume(const std::string& id) {
   if (!job) return std::unexpected(error(rpc_code::job_not_found, fmt::format("no job {}", id)));
   if (auto refused = store_refusal()) return std::unexpected(*refused);
   if (job->state == JobState::paused && pause_ == PauseKind::hold && cutting_) {
-    drivers::CutJob* cut = cut_.get();
+    std::shared_ptr<drivers::CutJob> cut = cut_;
     cut->continue_motion();  // jet on again first, then the cycle start (line and PLC): CutJob's hold watch
     pause_ = PauseKind::none;
     (void)set_state(*job, JobState::cutting);
@@ -387,18 +387,23 @@ nlohmann::json JobManager::machine_status() {
   return status;
 }
 
+// The machine first, the bookkeeping after: the hold reaches the line and the PLC without
+// waiting for the database (a synced write) or for anyone holding the lock.
 std::expected<nlohmann::json, RpcError> JobManager::hold() {
-  drivers::CutJob* cut = nullptr;
+  std::shared_ptr<drivers::CutJob> cut;
   {
     std::lock_guard lock(mutex_);
     JobRecord* job = find(machine_job_);
     if (!job || job->state != JobState::cutting || !cutting_)
       return std::unexpected(error(rpc_code::invalid_state, "nothing is cutting"));
-    cut = cut_.get();
+    cut = cut_;
+  }
+  cut->hold();  // the line's real-time byte and the PLC's button (a drip feed has no hold on its line)
+  std::lock_guard lock(mutex_);
+  if (JobRecord* job = find(machine_job_); job && job->state == JobState::cutting && cutting_ && cut_ == cut) {
     pause_ = PauseKind::hold;
     (void)set_state(*job, JobState::paused, "held by the operator");
   }
-  cut->hold();  // the line's real-time byte and the PLC's button (a drip feed has no hold on its line)
   return nlohmann::json{{"held", true}};
 }
 
@@ -415,11 +420,11 @@ std::expected<nlohmann::json, RpcError> JobManager::resume_motion() {
 }
 
 std::expected<nlohmann::json, RpcError> JobManager::abort(const std::string& why) {
-  drivers::CutJob* cut = nullptr;
+  std::shared_ptr<drivers::CutJob> cut;
   {
     std::lock_guard lock(mutex_);
     if (!cutting_) return std::unexpected(error(rpc_code::invalid_state, "nothing is cutting"));
-    cut = cut_.get();
+    cut = cut_;
   }
   cut->abort(why);  // the cut stops safely; its job becomes paused with a resume point
   return nlohmann::json{{"aborted", true}};

@@ -106,7 +106,9 @@ class JobManager {
 
   std::string machine_job_;           // the job that owns the machine (empty: free)
   std::string cancel_after_stop_;     // cancel this job when its cut has stopped
-  std::unique_ptr<drivers::CutJob> cut_;  // the cut of machine_job_'s current sheet
+  // The cut of machine_job_'s current sheet. Shared: hold and abort act on it outside the lock,
+  // and a cut that ends meanwhile must not be destroyed under them.
+  std::shared_ptr<drivers::CutJob> cut_;
   std::thread cutter_;
   bool cutting_ = false;              // cutter_ is streaming
   PauseKind pause_ = PauseKind::none;

@@ -1,6 +1,7 @@
 #include "plan_process.hpp"
 
 #include <fcntl.h>
+#include <pthread.h>
 #include <signal.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
@@ -69,6 +70,15 @@ void drain_progress(int fd, std::string& pending, const PlanProgressCallback& on
   auto note = [log_fd](const char* what) {
     (void)!::write(log_fd, what, std::strlen(what));
   };
+  // Every signal is blocked here (spawn_limited): laminad's handlers are still installed, and
+  // Asio's writes to laminad's own pipe — a cancel's SIGTERM arriving now used to make laminad
+  // itself shut down. Defaults first, then nothing blocked: a pending SIGTERM then ends the child.
+  struct sigaction default_action {};
+  default_action.sa_handler = SIG_DFL;
+  for (int sig = 1; sig < NSIG; ++sig) ::sigaction(sig, &default_action, nullptr);
+  sigset_t none;
+  ::sigemptyset(&none);
+  ::sigprocmask(SIG_SETMASK, &none, nullptr);
   if (limits.memory_bytes > 0) {
     const rlimit as{static_cast<rlim_t>(limits.memory_bytes), static_cast<rlim_t>(limits.memory_bytes)};
     if (::setrlimit(RLIMIT_AS, &as) != 0) note("warning: the planner's memory limit was refused\n");
@@ -97,8 +107,14 @@ void drain_progress(int fd, std::string& pending, const PlanProgressCallback& on
 
 // fork + limits + exec (posix_spawn cannot set rlimits); -1 and errno when fork fails.
 pid_t spawn_limited(std::vector<char*>& argv, int log_fd, int progress_fd, const PlanLimits& limits) {
+  sigset_t all, before;
+  ::sigfillset(&all);
+  ::pthread_sigmask(SIG_SETMASK, &all, &before);
   const pid_t pid = ::fork();
   if (pid == 0) exec_child(argv.data(), log_fd, progress_fd, limits);
+  const int fork_errno = errno;
+  ::pthread_sigmask(SIG_SETMASK, &before, nullptr);
+  errno = fork_errno;
   return pid;
 }
 

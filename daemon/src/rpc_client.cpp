@@ -167,6 +167,13 @@ RpcClient::ReadStatus RpcClient::read_line(std::string& line, std::int64_t deadl
 
 std::expected<json, RpcError> RpcClient::call(const std::string& method, json params, double timeout_s) {
   if (fd_ < 0) return transport("not connected");
+  // Over TCP the daemon reads only a few KiB of a line until a request has shown the token: a
+  // large first request (an upload chunk) goes after a small one that does.
+  constexpr std::size_t kSmallFirstRequest = 2048;
+  if (via_tcp_ && next_id_ == 1 && method != "server.info" && params.dump().size() > kSmallFirstRequest) {
+    auto hello = call("server.info", json::object(), timeout_s);
+    if (!hello && (hello.error().code == rpc_code::unauthorized || fd_ < 0)) return hello;
+  }
   const std::int64_t id = next_id_++;
   if (via_tcp_) {
     if (params.is_null()) params = json::object();

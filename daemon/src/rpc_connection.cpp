@@ -5,6 +5,7 @@
 #include <utility>
 
 #include <boost/asio/error.hpp>
+#include <boost/asio/post.hpp>
 #include <boost/asio/write.hpp>
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
@@ -15,6 +16,12 @@ namespace lamina::daemon::rpc_detail {
 namespace {
 
 constexpr std::size_t read_chunk_bytes = 64 * 1024;
+// Lines longer than this are parsed on the worker: even valid JSON takes milliseconds per MiB.
+constexpr std::size_t parse_on_worker_bytes = 64 * 1024;
+// Queued for the worker beyond this, the socket is not read until the worker catches up.
+constexpr std::size_t max_waiting_requests = 32;
+// A client has been quiet this long before it may be dropped to make room for a new one.
+constexpr auto evict_after_idle = std::chrono::seconds(1);
 // How long a connection refused for an oversize line may take to read the error and hang up.
 constexpr auto linger_after_refusal = std::chrono::seconds(2);
 
@@ -29,10 +36,41 @@ Connection::Connection(Socket socket, ClientContext context, std::string peer, s
       on_closed_(std::move(on_closed)),
       chunk_(read_chunk_bytes) {}
 
+bool ServerShared::is_inline(std::string_view method) const {
+  for (const auto& m : settings.inline_methods)
+    if (m == method) return true;
+  return false;
+}
+
 void Connection::start() {
   shared_->log->debug("client {} connected ({})", context_.id, peer_);
+  arm_idle_timer();
   read_next();
 }
+
+bool Connection::evictable(std::chrono::steady_clock::time_point now) const {
+  return !closed_ && !context_.subscribed && !busy_ && waiting_.empty() && now - last_active_ >= evict_after_idle;
+}
+
+// The pre-auth deadline of a TCP peer without a valid token yet, else the idle timeout; moved
+// on by every request (expires_after cancels the wait before).
+void Connection::arm_idle_timer() {
+  const bool pre_auth = context_.via_tcp && !authenticated_;
+  const double seconds = pre_auth ? shared_->settings.pre_auth_timeout_s : shared_->settings.idle_timeout_s;
+  if (seconds <= 0) return;
+  if (!idle_timer_) idle_timer_.emplace(socket_.get_executor());
+  idle_timer_->expires_after(std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+      std::chrono::duration<double>(seconds)));
+  idle_timer_->async_wait([self = shared_from_this(), pre_auth, seconds](const boost::system::error_code& error) {
+    std::lock_guard lock(self->shared_->mutex);
+    if (error || self->closed_) return;
+    if (pre_auth && !self->authenticated_) return self->close(fmt::format("no valid token within {} s", seconds));
+    if (self->context_.subscribed || self->busy_ || !self->waiting_.empty()) return self->arm_idle_timer();
+    self->close(fmt::format("idle for {} s", seconds));
+  });
+}
+
+bool Connection::may_close_after_eof() const { return !writing_ && !busy_ && waiting_.empty(); }
 
 void Connection::read_next() {
   socket_.async_read_some(boost::asio::buffer(chunk_),
@@ -50,7 +88,7 @@ void Connection::on_read(const boost::system::error_code& error, std::size_t siz
     // without '\n' is still a request, and the replies still go out before the close.
     if (!partial_.empty()) handle_line(std::exchange(partial_, {}));
     peer_done_ = true;
-    if (!closed_ && !writing_) close("client hung up");
+    if (!closed_ && may_close_after_eof()) close("client hung up");
     return;
   }
   if (error) {
@@ -61,7 +99,9 @@ void Connection::on_read(const boost::system::error_code& error, std::size_t siz
     read_next();
     return;
   }
-  const std::size_t limit = shared_->settings.max_request_bytes;
+  // Before its token, a TCP peer gets a few KiB per line, not the MiB a client may send.
+  const std::size_t limit = context_.via_tcp && !authenticated_ ? shared_->settings.pre_auth_max_bytes
+                                                                : shared_->settings.max_request_bytes;
   std::string_view data(chunk_.data(), size);
   while (!closed_ && !draining_) {
     const std::size_t newline = data.find('\n');
@@ -89,43 +129,124 @@ void Connection::on_read(const boost::system::error_code& error, std::size_t siz
     }
     data.remove_prefix(newline + 1);
   }
-  if (!closed_) read_next();
+  if (closed_) return;
+  // Backpressure: a client far ahead of the worker waits (in its socket) until it catches up.
+  if (waiting_.size() >= max_waiting_requests || waiting_bytes_ > shared_->settings.max_request_bytes)
+    read_paused_ = true;
+  else
+    read_next();
 }
 
 void Connection::handle_line(std::string_view line) {
   if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
   // Blank lines (someone typing into socat) are not requests and get no error.
   if (line.find_first_not_of(" \t") == std::string_view::npos) return;
+  last_active_ = std::chrono::steady_clock::now();
+  arm_idle_timer();
+  // (Only an authenticated client can send a line this long: see on_read.)
+  if (line.size() > parse_on_worker_bytes) {
+    waiting_.push_back(Pending{std::nullopt, std::string(line), line.size()});
+    waiting_bytes_ += line.size();
+    return dispatch_next();
+  }
+  auto request = accept_request(line);
+  if (!request) return;
+  if (shared_->is_inline(request->method)) {  // ahead of whatever waits for the worker
+    RpcResult result = invoke(*request, context_);
+    if (request->is_notification || closed_) return;  // the handler may have stopped the server
+    return send_line(result ? result_line(request->id, *result) : error_line(request->id, result.error()));
+  }
+  waiting_bytes_ += line.size();
+  waiting_.push_back(Pending{std::move(*request), {}, line.size()});
+  dispatch_next();
+}
 
+std::optional<RpcRequest> Connection::accept_request(std::string_view line) {
   auto parsed = parse_request(line);
   if (!parsed) {
     shared_->log->info("client {}: {} ({})", context_.id, parsed.error().error.message, parsed.error().error.code);
-    send_line(error_line(parsed.error().id, parsed.error().error));
-    return;
+    if (context_.via_tcp && !authenticated_)  // a stranger gets one answer, not a parser to play with
+      refuse_and_hang_up(error_line(parsed.error().id, parsed.error().error), "bad request before a valid token");
+    else
+      send_line(error_line(parsed.error().id, parsed.error().error));
+    return std::nullopt;
   }
-  RpcRequest& request = *parsed;
   if (context_.via_tcp) {
-    if (auto authorized = check_and_strip_token(request.params, shared_->settings.token); !authorized) {
-      shared_->log->warn("client {} ({}): {} without a valid token", context_.id, peer_, request.method);
-      if (!request.is_notification) send_line(error_line(request.id, authorized.error()));
-      return;
+    if (auto authorized = check_and_strip_token(parsed->params, shared_->settings.token); !authorized) {
+      shared_->log->warn("client {} ({}): {} without a valid token", context_.id, peer_, parsed->method);
+      const std::string reply = error_line(parsed->id, authorized.error());
+      if (!authenticated_) refuse_and_hang_up(reply, "no valid token");
+      else if (!parsed->is_notification) send_line(reply);
+      return std::nullopt;
+    }
+    if (!authenticated_) {
+      authenticated_ = true;
+      arm_idle_timer();  // the idle timeout from now on, not the pre-auth deadline
     }
   }
-  RpcResult result = invoke(request);
-  if (request.is_notification || closed_) return;  // the handler may have stopped the server
-  send_line(result ? result_line(request.id, *result) : error_line(request.id, result.error()));
+  return std::move(*parsed);
 }
 
-RpcResult Connection::invoke(const RpcRequest& request) {
+// The next waiting request to the worker, once the one before has come back (replies in order).
+void Connection::dispatch_next() {
+  if (busy_ || closed_ || waiting_.empty()) return;
+  Pending next = std::move(waiting_.front());
+  waiting_.pop_front();
+  waiting_bytes_ -= next.bytes;
+  busy_ = true;
+  if (read_paused_ && !draining_) {
+    read_paused_ = false;
+    read_next();
+  }
+  boost::asio::post(shared_->worker, [self = shared_from_this(), next = std::move(next), context = context_]() mutable {
+    nlohmann::json id;
+    bool notification = false;
+    RpcResult result = std::unexpected(RpcError{rpc_code::internal_error, "internal error", {}});
+    std::optional<RpcRequest> request = std::move(next.request);
+    if (!request) {  // a long line: parsed here, its token checked here
+      auto parsed = parse_request(next.raw);
+      if (!parsed) result = std::unexpected(parsed.error().error), id = parsed.error().id;
+      else if (auto ok = context.via_tcp ? check_and_strip_token(parsed->params, self->shared_->settings.token)
+                                         : std::expected<void, RpcError>{};
+               !ok)
+        result = std::unexpected(ok.error()), id = parsed->id;
+      else request = std::move(*parsed);
+    }
+    if (request) {
+      id = request->id;
+      notification = request->is_notification;
+      result = self->invoke(*request, context);
+    }
+    // The handler worked on a copy of the client's context: what it changed (a subscription)
+    // is applied on the io thread, where broadcasts read it.
+    boost::asio::post(self->socket_.get_executor(), [self, id = std::move(id), notification, result = std::move(result),
+                                                     subscribed = context.subscribed] {
+      std::lock_guard lock(self->shared_->mutex);
+      self->context_.subscribed = subscribed;
+      self->on_worker_done(id, notification, result);
+    });
+  });
+}
+
+void Connection::on_worker_done(const nlohmann::json& id, bool notification, RpcResult result) {
+  busy_ = false;
+  if (closed_) return;
+  if (!notification) send_line(result ? result_line(id, *result) : error_line(id, result.error()));
+  if (closed_) return;
+  dispatch_next();
+  if (peer_done_ && may_close_after_eof()) close("client hung up");
+}
+
+RpcResult Connection::invoke(const RpcRequest& request, ClientContext& context) {
   if (!shared_->handler) return std::unexpected(RpcError{rpc_code::shutting_down, "shutting down", {}});
   // A handler's bug must cost one reply, not the daemon (and the machine it drives).
   try {
-    return shared_->handler(request, context_);
+    return shared_->handler(request, context);
   } catch (const std::exception& e) {
-    shared_->log->error("client {}: {} threw: {}", context_.id, request.method, e.what());
+    shared_->log->error("client {}: {} threw: {}", context.id, request.method, e.what());
     return std::unexpected(RpcError{rpc_code::internal_error, "internal error", e.what()});
   } catch (...) {
-    shared_->log->error("client {}: {} threw a non-standard exception", context_.id, request.method);
+    shared_->log->error("client {}: {} threw a non-standard exception", context.id, request.method);
     return std::unexpected(RpcError{rpc_code::internal_error, "internal error", {}});
   }
 }
@@ -133,20 +254,34 @@ RpcResult Connection::invoke(const RpcRequest& request) {
 void Connection::send_line(std::string line) { send(std::make_shared<const std::string>(std::move(line))); }
 
 void Connection::refuse_oversize(std::size_t bytes) {
-  const std::size_t limit = shared_->settings.max_request_bytes;
+  const std::size_t limit = context_.via_tcp && !authenticated_ ? shared_->settings.pre_auth_max_bytes
+                                                                : shared_->settings.max_request_bytes;
   shared_->log->warn("client {} ({}): request of {} bytes over the limit of {}; closing", context_.id, peer_, bytes,
                      limit);
-  draining_ = true;
   partial_.clear();
   partial_.shrink_to_fit();
-  send_line(error_line(nullptr, RpcError{rpc_code::invalid_request,
-                                         fmt::format("request too large ({} bytes, limit {})", bytes, limit),
-                                         {}}));
+  refuse_and_hang_up(error_line(nullptr, RpcError{rpc_code::invalid_request,
+                                                  fmt::format("request too large ({} bytes, limit {}{})", bytes, limit,
+                                                              limit < shared_->settings.max_request_bytes
+                                                                  ? " before a valid token"
+                                                                  : ""),
+                                                  {}}),
+                     "request too large");
+}
+
+// The reply is written, input is read and discarded (closing with unread input would make TCP
+// send a reset that can destroy the reply before the client reads it), and the connection
+// closes on the client's EOF or when linger_ expires.
+void Connection::refuse_and_hang_up(std::string line, std::string_view why) {
+  draining_ = true;
+  waiting_.clear();
+  waiting_bytes_ = 0;
+  send_line(std::move(line));
   if (closed_) return;  // the reply alone passed max_queued_bytes
   linger_.emplace(socket_.get_executor(), linger_after_refusal);
-  linger_->async_wait([self = shared_from_this()](const boost::system::error_code& error) {
+  linger_->async_wait([self = shared_from_this(), why = std::string(why)](const boost::system::error_code& error) {
     std::lock_guard lock(self->shared_->mutex);
-    if (!error) self->close("did not hang up after a refused request");
+    if (!error) self->close(fmt::format("did not hang up after: {}", why));
   });
 }
 
@@ -190,9 +325,9 @@ void Connection::on_write(const boost::system::error_code& error) {
   in_flight_.clear();
   if (!queue_.empty()) {
     write_next();
-  } else if (peer_done_) {
+  } else if (peer_done_ && may_close_after_eof()) {
     close("client hung up");
-  } else if (draining_) {
+  } else if (draining_ && !peer_done_) {
     // The refusal is out: half-close so the client sees EOF, and keep discarding its input until
     // it hangs up too (or linger_ expires).
     boost::system::error_code ignored;
@@ -210,7 +345,9 @@ void Connection::close(std::string_view reason) {
   boost::system::error_code ignored;
   socket_.close(ignored);  // pending operations complete with operation_aborted
   if (linger_) linger_->cancel();
+  if (idle_timer_) idle_timer_->cancel();
   queue_.clear();
+  waiting_.clear();
   // in_flight_ stays: the aborted write's buffers point into it until its handler has run.
 }
 

@@ -2,6 +2,7 @@
 // One client of rpc_server: reads newline-delimited requests, runs the handler, queues replies.
 // Used by rpc_server.cpp only; the server owns connections through shared_ptr and every
 // completion handler holds one too, so a connection outlives any operation still in flight.
+#include <chrono>
 #include <cstddef>
 #include <cstdint>
 #include <deque>
@@ -15,6 +16,7 @@
 
 #include <boost/asio/buffer.hpp>
 #include <boost/asio/generic/stream_protocol.hpp>
+#include <boost/asio/io_context.hpp>
 #include <boost/asio/steady_timer.hpp>
 #include <spdlog/logger.h>
 
@@ -33,6 +35,10 @@ struct ServerShared {
   // thread, including when the io_context is not running. Uncontended in normal operation (one io
   // thread); recursive because a handler may call stop().
   std::recursive_mutex mutex;
+  // The handlers of methods not in settings.inline_methods run here, one at a time, without the
+  // mutex (RpcServer owns the thread; it is joined before the handler is emptied).
+  boost::asio::io_context worker;
+  bool is_inline(std::string_view method) const;
 };
 
 class Connection : public std::enable_shared_from_this<Connection> {
@@ -53,14 +59,31 @@ class Connection : public std::enable_shared_from_this<Connection> {
   // Idempotent. Queued replies are discarded; on_closed runs once.
   void close(std::string_view reason);
   const ClientContext& context() const { return context_; }
+  // For the server choosing whom to drop when a kind of client is full.
+  bool evictable(std::chrono::steady_clock::time_point now) const;
+  std::chrono::steady_clock::time_point last_active() const { return last_active_; }
 
  private:
+  // A request waiting for the worker: parsed, or a long line the worker parses (a MiB of JSON
+  // takes milliseconds the io thread has not).
+  struct Pending {
+    std::optional<RpcRequest> request;
+    std::string raw;
+    std::size_t bytes = 0;  // the line's length, for waiting_bytes_
+  };
+
   void read_next();
   void on_read(const boost::system::error_code& error, std::size_t size);
   void handle_line(std::string_view line);
-  RpcResult invoke(const RpcRequest& request);
+  std::optional<RpcRequest> accept_request(std::string_view line);  // parsed and authorised, or replied to
+  void dispatch_next();
+  void on_worker_done(const nlohmann::json& id, bool notification, RpcResult result);
+  RpcResult invoke(const RpcRequest& request, ClientContext& context);  // the handler, exceptions caught
   void send_line(std::string line);
   void refuse_oversize(std::size_t bytes);
+  void refuse_and_hang_up(std::string line, std::string_view why);
+  void arm_idle_timer();
+  bool may_close_after_eof() const;
   void write_next();
   void on_write(const boost::system::error_code& error);
 
@@ -86,6 +109,14 @@ class Connection : public std::enable_shared_from_this<Connection> {
   bool peer_done_ = false;  // the client half-closed: close once its replies are written
   std::optional<boost::asio::steady_timer> linger_;
   bool closed_ = false;
+
+  bool authenticated_ = false;              // TCP: a request with the right token was seen
+  std::deque<Pending> waiting_;             // for the worker, in order
+  std::size_t waiting_bytes_ = 0;
+  bool busy_ = false;                       // one of ours is on the worker
+  bool read_paused_ = false;                // waiting_ is full: the socket is not read
+  std::chrono::steady_clock::time_point last_active_ = std::chrono::steady_clock::now();
+  std::optional<boost::asio::steady_timer> idle_timer_;  // idle timeout, or the pre-auth deadline
 };
 
 }  // namespace lamina::daemon::rpc_detail

@@ -22,9 +22,11 @@
 #include <cstring>
 #include <map>
 #include <mutex>
+#include <thread>
 #include <utility>
 #include <vector>
 
+#include <boost/asio/executor_work_guard.hpp>
 #include <boost/asio/ip/tcp.hpp>
 #include <boost/asio/local/stream_protocol.hpp>
 #include <boost/asio/post.hpp>
@@ -117,6 +119,9 @@ struct RpcServer::Impl : std::enable_shared_from_this<RpcServer::Impl> {
   ino_t owned_inode = 0;
   std::atomic<int> bound_tcp_port{0};
   std::atomic<std::size_t> clients{0};
+  // The worker thread of ServerShared::worker (see rpc_connection.hpp).
+  std::optional<boost::asio::executor_work_guard<boost::asio::io_context::executor_type>> worker_guard;
+  std::thread worker_thread;
 
   const RpcServerSettings& settings() const { return shared->settings; }
   spdlog::logger& log() const { return *shared->log; }
@@ -250,18 +255,41 @@ struct RpcServer::Impl : std::enable_shared_from_this<RpcServer::Impl> {
     } else {
       peer = unix_peer(socket.native_handle());
     }
-    if (connections.size() >= settings().max_clients) {
-      refuse(socket, peer);
+    if (count(via_tcp) >= settings().max_clients && !evict_one(via_tcp)) {
+      refuse(socket, peer, via_tcp);
       return;
     }
     admit(std::move(socket), via_tcp, std::move(peer));
   }
 
+  std::size_t count(bool via_tcp) const {
+    std::size_t n = 0;
+    for (const auto& [id, connection] : connections) n += connection->context().via_tcp == via_tcp;
+    return n;
+  }
+
+  // 128 idle connections used to lock every new client out until a restart: the longest-idle
+  // one of the same kind makes room (never a subscriber, nor one with a request in flight).
+  bool evict_one(bool via_tcp) {
+    const auto now = std::chrono::steady_clock::now();
+    std::shared_ptr<Connection> oldest;
+    for (const auto& [id, connection] : connections)
+      if (connection->context().via_tcp == via_tcp && connection->evictable(now) &&
+          (!oldest || connection->last_active() < oldest->last_active()))
+        oldest = connection;
+    if (!oldest) return false;
+    oldest->close(fmt::format("the longest idle of {} {} clients, dropped to make room", settings().max_clients,
+                              via_tcp ? "TCP" : "Unix"));
+    return true;
+  }
+
   template <typename Socket>
-  void refuse(Socket& socket, const std::string& peer) {
-    log().warn("refusing {}: {} clients connected (max_clients)", peer, connections.size());
+  void refuse(Socket& socket, const std::string& peer, bool via_tcp) {
+    const char* kind = via_tcp ? "TCP" : "Unix";
+    log().warn("refusing {}: {} {} clients connected, none idle (max_clients)", peer, count(via_tcp), kind);
     const std::string line = rpc_detail::error_line(
-        nullptr, RpcError{rpc_detail::too_many_clients, fmt::format("too many clients (limit {})", settings().max_clients), {}});
+        nullptr, RpcError{rpc_detail::too_many_clients,
+                          fmt::format("too many {} clients (limit {}, none idle)", kind, settings().max_clients), {}});
     boost::system::error_code ignored;
     // A fresh socket's send buffer is empty, so this short write does not block; it is best effort.
     socket.non_blocking(true, ignored);
@@ -329,11 +357,21 @@ RpcServer::RpcServer(boost::asio::io_context& io, RpcServerSettings settings, Ha
   shared->handler = std::move(handler);
   shared->log = rpc_logger();
   impl_ = std::make_shared<Impl>(io, std::move(shared));
+  impl_->worker_guard.emplace(impl_->shared->worker.get_executor());
+  impl_->worker_thread = std::thread([shared = impl_->shared] { shared->worker.run(); });
 }
 
 RpcServer::~RpcServer() {
+  {
+    std::lock_guard lock(impl_->shared->mutex);
+    impl_->stop("server destroyed");
+  }
+  // A handler still running on the worker finishes (its reply finds the connection closed);
+  // none starts after this. Not under the lock: the handler's reply takes it.
+  impl_->worker_guard.reset();
+  impl_->shared->worker.stop();
+  if (impl_->worker_thread.joinable()) impl_->worker_thread.join();
   std::lock_guard lock(impl_->shared->mutex);
-  impl_->stop("server destroyed");
   // Completion handlers still queued keep the shared state alive; they find every connection
   // closed, and with the handler gone nothing it captured can be reached any more.
   impl_->shared->handler = nullptr;

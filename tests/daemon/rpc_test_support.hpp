@@ -154,7 +154,9 @@ inline std::string request_line(const json& id, const std::string& method, const
 // The server under test, on its own io thread. Methods of its handler:
 //   echo → params; add → params.a + params.b; whoami → {client, tcp}; big → a string of
 //   params.bytes 'x'; note → counts calls (for notifications); throw → throws;
-//   server.subscribe → subscribes the client; stop → stops the server from inside a handler.
+//   server.subscribe → subscribes the client; stop → stops the server from inside a handler;
+//   block → waits (on the worker) until the test sets release_ (at most 20 s); hold → "held"
+//   (a test makes it an inline method).
 class ServerFixture : public ::testing::Test {
  protected:
   void SetUp() override { spdlog::set_level(spdlog::level::warn); }
@@ -217,6 +219,12 @@ class ServerFixture : public ::testing::Test {
       client.subscribed = true;
       return true;
     }
+    if (request.method == "block") {
+      ++blocked_;
+      for (int i = 0; i < 2000 && !release_; ++i) std::this_thread::sleep_for(10ms);
+      return release_.load();
+    }
+    if (request.method == "hold") return "held";
     if (request.method == "stop") {
       server_->stop();
       return true;
@@ -230,6 +238,8 @@ class ServerFixture : public ::testing::Test {
   std::thread thread_;
   std::unique_ptr<RpcServer> server_;
   std::atomic<int> notes_{0};
+  std::atomic<int> blocked_{0};
+  std::atomic<bool> release_{false};
 };
 
 }  // namespace lamina::daemon::test

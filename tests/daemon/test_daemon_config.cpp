@@ -60,6 +60,9 @@ void expect_same(const DaemonConfig& a, const DaemonConfig& b) {
   EXPECT_EQ(a.server.tcp_port, b.server.tcp_port);
   EXPECT_EQ(a.server.token, b.server.token);
   EXPECT_EQ(a.server.max_request_bytes, b.server.max_request_bytes);
+  EXPECT_EQ(a.server.max_clients, b.server.max_clients);
+  EXPECT_EQ(a.server.idle_timeout_s, b.server.idle_timeout_s);
+  EXPECT_EQ(a.server.pre_auth_timeout_s, b.server.pre_auth_timeout_s);
   EXPECT_EQ(a.link.protocol, b.link.protocol);
   EXPECT_EQ(a.link.port, b.link.port);
   EXPECT_EQ(a.link.tcp, b.link.tcp);
@@ -105,7 +108,7 @@ TEST(DaemonConfig, TheDefaultsFileShowsEveryKey) {
   std::ifstream in(kSource / "config/lamina.toml");
   std::string text((std::istreambuf_iterator<char>(in)), {});
   for (const char* key : {"state_dir", "socket", "socket_mode", "socket_group", "tcp", "token", "token_file",
-                          "max_request_bytes", "protocol", "port", "baud", "rx_buffer", "status_hz", "enabled",
+                          "max_request_bytes", "max_clients", "idle_timeout_s", "pre_auth_timeout_s", "protocol", "port", "baud", "rx_buffer", "status_hz", "enabled",
                           "modbus", "heartbeat_period_s", "pump_ready_timeout_s", "pressure_setpoint_mpa",
                           "abrasive_g_per_min", "hold_limit_s", "jet_restart_s", "lamina", "workers", "machine",
                           "materials", "timeout_s", "memory_limit_mb", "cpu_limit_s", "nice", "roots",

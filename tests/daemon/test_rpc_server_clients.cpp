@@ -128,7 +128,7 @@ TEST_F(RpcClients, ClientsPastMaxClientsAreTurnedAway) {
   auto third = RawConn::unix_socket(socket_path());
   const auto refusal = third.read_json(3s);
   ASSERT_TRUE(refusal.has_value());
-  EXPECT_EQ(refusal->at("error").at("message"), "too many clients (limit 2)");
+  EXPECT_EQ(refusal->at("error").at("message"), "too many Unix clients (limit 2, none idle)");
   EXPECT_TRUE(third.wait_closed(3s));
   EXPECT_EQ(server_->client_count(), 2U);
 

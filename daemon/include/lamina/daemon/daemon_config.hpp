@@ -19,6 +19,9 @@ struct ServerConfig {
   int tcp_port = 0;
   std::string token;                       // required when TCP is on (or token_file)
   std::size_t max_request_bytes = 1 << 20;
+  std::size_t max_clients = 64;            // per kind (Unix, TCP); the longest idle makes room
+  double idle_timeout_s = 600;             // a client silent this long (not subscribed) is closed; 0: never
+  double pre_auth_timeout_s = 10;          // TCP: a valid token within this, or closed
 };
 
 struct MachineLinkConfig {

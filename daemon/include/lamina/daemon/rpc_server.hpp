@@ -10,6 +10,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <boost/asio/io_context.hpp>
 #include <nlohmann/json.hpp>
@@ -61,12 +62,26 @@ struct RpcServerSettings {
   std::string token;                     // required for TCP
   std::size_t max_request_bytes = 1 << 20;
   std::size_t max_queued_bytes = 8 << 20;
-  std::size_t max_clients = 128;
+  // Per kind: Unix and TCP clients have their own slots, so TCP peers cannot lock out the
+  // operator's terminal. When a kind is full, its longest-idle client (not subscribed, nothing
+  // in flight, idle ≥ 1 s) makes room; only when none can is the new one refused.
+  std::size_t max_clients = 64;
+  // A TCP peer before its first request with the right token: its lines are at most this long,
+  // and it is closed after this long (a wrong token closes it at once).
+  std::size_t pre_auth_max_bytes = 4096;
+  double pre_auth_timeout_s = 10;
+  double idle_timeout_s = 600;            // no request this long, not subscribed: closed (0: never)
+  // Run on the io thread as they arrive, ahead of anything the client queued before (the
+  // operator's hold and abort, as grblHAL's real-time commands bypass its line queue). Every
+  // other method runs on one worker thread, in order per client, so that a slow one (a file
+  // copied, a thread joined, the database synced) never holds up the io thread.
+  std::vector<std::string> inline_methods;
 };
 
 class RpcServer {
  public:
-  // Handlers run on the io thread and must return quickly (no planning, no blocking I/O).
+  // Handlers of inline_methods run on the io thread and must return at once; the others run on
+  // the server's worker thread (one at a time) and may block for a while, never for long.
   using Handler = std::function<RpcResult(const RpcRequest&, ClientContext&)>;
 
   RpcServer(boost::asio::io_context& io, RpcServerSettings settings, Handler handler);
