@@ -24,7 +24,9 @@ std::shared_ptr<spdlog::logger> log() {
   return logger;
 }
 
-std::vector<std::string> read_program(const std::string& path) {
+}  // namespace
+
+std::vector<std::string> JobManager::read_program(const std::string& path) {
   std::vector<std::string> lines;
   std::ifstream in(path);
   for (std::string line; std::getline(in, line);) {
@@ -33,6 +35,8 @@ std::vector<std::string> read_program(const std::string& path) {
   }
   return lines;
 }
+
+namespace {
 
 SheetRecord* sheet_of(JobRecord& job, int index) {
   for (SheetRecord& s : job.sheets)
@@ -47,14 +51,29 @@ bool still(drivers::ControllerState s) {
 
 }  // namespace
 
+JobManager::ProgramRead JobManager::read_current_program(const std::string& job_id) const {
+  ProgramRead read;
+  {
+    std::lock_guard lock(mutex_);
+    const JobRecord* job = find(job_id);
+    if (!job) return read;
+    for (const SheetRecord& s : job->sheets)
+      if (s.index == job->current_sheet) read.path = s.program_path;
+  }
+  if (!read.path.empty()) read.lines = read_program(read.path);
+  return read;
+}
+
 // Under mutex_. Joins the previous cutting thread (it has left finish_cut: cutting_ is false).
 // Nothing moves unless the database has taken the job's `cutting` first: a cut it does not know
 // of would be cut again after a crash.
-std::expected<void, RpcError> JobManager::start_cut(JobRecord& job, CutStart how) {
+std::expected<void, RpcError> JobManager::start_cut(JobRecord& job, CutStart how, const ProgramRead& read) {
   if (cutter_.joinable()) cutter_.join();
   SheetRecord* sheet = sheet_of(job, job.current_sheet);
   if (!sheet) return std::unexpected(RpcError{rpc_code::internal_error, fmt::format("job {} has no sheet {}", job.id, job.current_sheet), nullptr});
-  std::vector<std::string> program = read_program(sheet->program_path);
+  // Read before the lock was taken (a long program must not hold up the operator's hold); again
+  // here only if the sheet changed meanwhile.
+  std::vector<std::string> program = read.path == sheet->program_path ? read.lines : read_program(sheet->program_path);
   if (program.empty()) {
     const std::string why = fmt::format("{}: no program lines", sheet->program_path);
     (void)set_state(job, JobState::interrupted, why);

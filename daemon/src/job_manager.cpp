@@ -330,6 +330,7 @@ std::expected<JobRecord, RpcError> JobManager::cancel(const std::string& id) {
 }
 
 std::expected<JobRecord, RpcError> JobManager::confirm_sheet(const std::string& id, int sheet) {
+  const ProgramRead program = read_current_program(id);
   std::lock_guard lock(mutex_);
   JobRecord* job = find(id);
   if (!job) return std::unexpected(error(rpc_code::job_not_found, fmt::format("no job {}", id)));
@@ -339,11 +340,12 @@ std::expected<JobRecord, RpcError> JobManager::confirm_sheet(const std::string& 
   if (sheet != job->current_sheet)
     return std::unexpected(error(rpc_code::invalid_params,
                                  fmt::format("sheet {}: job {} waits for sheet {}", sheet, id, job->current_sheet)));
-  if (auto started = start_cut(*job, CutStart::fresh); !started) return std::unexpected(started.error());
+  if (auto started = start_cut(*job, CutStart::fresh, program); !started) return std::unexpected(started.error());
   return *job;
 }
 
 std::expected<JobRecord, RpcError> JobManager::resume(const std::string& id) {
+  const ProgramRead program = read_current_program(id);
   std::lock_guard lock(mutex_);
   JobRecord* job = find(id);
   if (!job) return std::unexpected(error(rpc_code::job_not_found, fmt::format("no job {}", id)));
@@ -357,13 +359,13 @@ std::expected<JobRecord, RpcError> JobManager::resume(const std::string& id) {
   }
   if (job->state == JobState::paused) {
     if (cutting_) return std::unexpected(error(rpc_code::machine_busy, "the cut is still stopping; try again"));
-    if (auto started = start_cut(*job, CutStart::resume_stopped); !started) return std::unexpected(started.error());
+    if (auto started = start_cut(*job, CutStart::resume_stopped, program); !started) return std::unexpected(started.error());
     return *job;
   }
   if (job->state == JobState::interrupted) {
     if (!machine_job_.empty() && machine_job_ != id)
       return std::unexpected(error(rpc_code::machine_busy, fmt::format("the machine is with job {}", machine_job_)));
-    if (auto started = start_cut(*job, CutStart::resume_interrupted); !started) return std::unexpected(started.error());
+    if (auto started = start_cut(*job, CutStart::resume_interrupted, program); !started) return std::unexpected(started.error());
     machine_job_ = id;
     return *job;
   }

@@ -77,7 +77,13 @@ class JobManager {
   void assign_machine();              // the oldest planned job gets the machine when it is free
   JobRecord* find(const std::string& id);
   const JobRecord* find(const std::string& id) const;
-  std::expected<void, RpcError> start_cut(JobRecord& job, CutStart how);
+  struct ProgramRead {
+    std::string path;
+    std::vector<std::string> lines;
+  };
+  static std::vector<std::string> read_program(const std::string& path);
+  ProgramRead read_current_program(const std::string& job_id) const;  // takes the lock briefly
+  std::expected<void, RpcError> start_cut(JobRecord& job, CutStart how, const ProgramRead& read);
   std::expected<void, RpcError> stage_inputs(JobRecord& job, const SubmitRequest& r) const;  // no lock needed
 
   // --- threads ---
