@@ -232,4 +232,18 @@ inline void expect_resumed_at_the_cut_short_contour(const std::vector<std::strin
     ASSERT_EQ(log[resumed_at + i].line, lines[contour_start + i]) << "resumed block " << i + 1;
 }
 
+// The example knob submitted on 5 mm stock, planned, its first sheet confirmed, and the CNC past
+// `blocks_before` executed blocks; the job's id.
+inline std::string start_cutting(RpcClient& c, Cell& cell, std::size_t blocks_before) {
+  Json job = call_ok(c, "job.submit", {{"model", std::string(LAMINA_EXAMPLES_DIR) + "/knob.stl"}, {"settings", {{"stock", "5"}}}});
+  const std::string id = job["id"];
+  job = wait_state(c, id, "waiting_sheet", 120);
+  if (job["state"] != "waiting_sheet") throw std::runtime_error("not planned: " + job.dump());
+  call_ok(c, "job.confirm_sheet", {{"job", id}, {"sheet", 1}});
+  if (!sim::testing::wait_status(cell.sim.control_port(),
+                                 [&](const Json& s) { return s["executed_blocks"].get<std::size_t>() > blocks_before; }, 60))
+    throw std::runtime_error("the cut did not start");
+  return id;
+}
+
 }  // namespace lamina::daemon::testing

@@ -161,11 +161,7 @@ TEST(LaminadProtocol, TheOperatorsHoldGetsThroughUnderAttack) {
   const int port = 20000 + ((::getpid() + 7) % 20000);
   Laminad daemon(cell.config(fmt::format("tcp = \"127.0.0.1:{}\"\ntoken = \"s3cret-token\"", port)), cell.dir.file(""));
   RpcClient c = connect(cell.socket());
-  Json job = call_ok(c, "job.submit", {{"model", std::string(LAMINA_EXAMPLES_DIR) + "/knob.stl"}, {"settings", {{"stock", "5"}}}});
-  const std::string id = job["id"];
-  ASSERT_EQ(wait_state(c, id, "waiting_sheet", 120)["state"], "waiting_sheet");
-  call_ok(c, "job.confirm_sheet", {{"job", id}, {"sheet", 1}});
-  ASSERT_TRUE(sim::testing::wait_status(cell.sim.control_port(), [](const Json& s) { return s["executed_blocks"] > 50; }, 60));
+  const std::string id = start_cutting(c, cell, 50);
 
   std::vector<int> idle;
   for (int i = 0; i < 130; ++i) {
@@ -214,11 +210,7 @@ TEST(LaminadProtocol, FiftyClientsWhileAJobStreamsAreAllAnswered) {
   Cell cell({}, 10);
   Laminad daemon(cell.config(), cell.dir.file(""));
   RpcClient c = connect(cell.socket());
-  Json job = call_ok(c, "job.submit", {{"model", std::string(LAMINA_EXAMPLES_DIR) + "/knob.stl"}, {"settings", {{"stock", "5"}}}});
-  const std::string id = job["id"];
-  ASSERT_EQ(wait_state(c, id, "waiting_sheet", 120)["state"], "waiting_sheet");
-  call_ok(c, "job.confirm_sheet", {{"job", id}, {"sheet", 1}});
-  ASSERT_TRUE(sim::testing::wait_status(cell.sim.control_port(), [](const Json& s) { return s["executed_blocks"] > 50; }, 60));
+  const std::string id = start_cutting(c, cell, 50);
   std::atomic<int> ok{0}, bad{0};
   std::vector<std::thread> clients;
   for (int i = 0; i < 50; ++i)

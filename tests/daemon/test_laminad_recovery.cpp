@@ -13,18 +13,6 @@ namespace {
 
 const std::string kModel = std::string(LAMINA_EXAMPLES_DIR) + "/knob.stl";
 
-std::string start_cutting(RpcClient& c, Cell& cell, std::size_t blocks_before) {
-  Json job = call_ok(c, "job.submit", {{"model", kModel}, {"settings", {{"stock", "5"}}}});
-  const std::string id = job["id"];
-  job = wait_state(c, id, "waiting_sheet", 120);
-  if (job["state"] != "waiting_sheet") throw std::runtime_error("not planned: " + job.dump());
-  call_ok(c, "job.confirm_sheet", {{"job", id}, {"sheet", 1}});
-  if (!sim::testing::wait_status(cell.sim.control_port(),
-                                 [&](const Json& s) { return s["executed_blocks"].get<std::size_t>() > blocks_before; }, 60))
-    throw std::runtime_error("the cut did not start");
-  return id;
-}
-
 // What the board does when a host opens its port (lamina-sim --on-open): greets, or reboots as
 // a classic Grbl does on DTR. The daemon opens the port only to cut, so on a resetting board
 // the resume's open resets the machine again before the resumed program: it must still work.

@@ -66,11 +66,8 @@ TEST(LaminadStorage, ADiskFullWhileCuttingStopsTheCutAndNothingRunsAheadOfTheDis
   if (!disk.mounted()) GTEST_SKIP() << "cannot mount a tmpfs here (" << disk.why() << ")";
   auto daemon = std::make_unique<Laminad>(cell.config(), cell.dir.file(""));
   RpcClient c = connect(cell.socket());
-  Json job = call_ok(c, "job.submit", {{"model", kModel}, {"settings", {{"stock", "5"}}}});
-  const std::string id = job["id"];
-  ASSERT_EQ(wait_state(c, id, "waiting_sheet", 120)["state"], "waiting_sheet") << daemon->log();
-  call_ok(c, "job.confirm_sheet", {{"job", id}, {"sheet", 1}});
-  ASSERT_TRUE(sim::testing::wait_status(cell.sim.control_port(), [](const Json& s) { return s["executed_blocks"] > 60; }, 60));
+  const std::string id = start_cutting(c, cell, 60);
+  Json job;
 
   ASSERT_GT(disk.fill("fill"), 0u);
   ASSERT_TRUE(wait_store_failed(c, 30)) << "the failed progress save is noticed\n" << daemon->log();
