@@ -4,9 +4,9 @@
 // existed before the fix is used, so bench/readers_old_vs_new.sh can build this same file against
 // the old lamina_core and run both side by side.
 //   build/bench/bench_readers --benchmark_filter=Obj
+#include "io_test_util.hpp"
 #include "lamina/core/mesh_io.hpp"
-#include "../core/src/polygon_triangulation.hpp"
-#include "../tests/core/io/io_test_util.hpp"
+#include "polygon_triangulation.hpp"  // core/src: the private header of the core being measured
 
 #include <benchmark/benchmark.h>
 #include <fmt/format.h>
@@ -18,39 +18,27 @@
 
 namespace {
 
-using lamina::test::make_zip;
-using lamina::test::stored;
-
-std::string model_xml(const std::string& resources, const std::string& build) {
-  return "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<model unit=\"millimeter\" "
-         "xmlns=\"http://schemas.microsoft.com/3dmanufacturing/core/2015/02\">\n<resources>\n" +
-         resources + "</resources>\n<build>\n" + build + "</build>\n</model>\n";
-}
-
-std::vector<std::byte> package(const std::string& xml) { return make_zip({stored("3D/3dmodel.model", xml)}); }
-
-const std::string kTriangle =
-    "<object id=\"1\" type=\"model\"><mesh><vertices><vertex x=\"0\" y=\"0\" z=\"0\"/><vertex x=\"1\" y=\"0\" "
-    "z=\"0\"/><vertex x=\"0\" y=\"1\" z=\"0\"/></vertices><triangles><triangle v1=\"0\" v2=\"1\" v3=\"2\"/>"
-    "</triangles></mesh></object>\n";
+using lamina::test::kTriangleObject;
+using lamina::test::model;
+using lamina::test::package;
 
 // Object k + 1 holds `fanout` components of object k; one build item of the top object, so the
 // build has fanout^levels triangles from a file of a few hundred bytes.
 std::vector<std::byte> nested_components(int levels, int fanout) {
-  std::string resources = kTriangle;
+  std::string resources = kTriangleObject;
   for (int k = 1; k <= levels; ++k) {
     resources += fmt::format("<object id=\"{}\" type=\"model\"><components>", k + 1);
     for (int c = 0; c < fanout; ++c)
       resources += fmt::format("<component objectid=\"{}\" transform=\"1 0 0 0 1 0 0 0 1 {} 0 0\"/>", k, c);
     resources += "</components></object>\n";
   }
-  return package(model_xml(resources, fmt::format("<item objectid=\"{}\"/>\n", levels + 1)));
+  return package(model(resources, fmt::format("<item objectid=\"{}\"/>\n", levels + 1)));
 }
 
 std::vector<std::byte> many_items(int items) {
   std::string build;
   for (int i = 0; i < items; ++i) build += fmt::format("<item objectid=\"1\" transform=\"1 0 0 0 1 0 0 0 1 {} 0 0\"/>\n", i);
-  return package(model_xml(kTriangle, build));
+  return package(model(kTriangleObject, build));
 }
 
 // An n-gon on the unit circle, or a star (every other corner at radius 0.5: n/2 reflex corners).

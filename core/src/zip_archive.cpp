@@ -214,7 +214,7 @@ std::expected<void, Error> check_sizes(const ZipEntry& e, std::string_view name,
     return std::unexpected(zip_error(
         ErrorCode::parse_error, name,
         fmt::format("zip entry {} declares {} than deflate can make from {}", label,
-                    quote.either(fmt::format("{} bytes", e.size), "more bytes"),
+                    quote.either(fmt::format("{} bytes, more", e.size), "more bytes"),
                     quote.either(fmt::format("{} compressed", e.compressed_size), "its compressed size"))));
   }
   const std::uint64_t bound = inflate_bound(e.compressed_size, options);
