@@ -22,6 +22,9 @@ namespace {
 
 // Polygons from this many vertices on get trees for their ear tests.
 constexpr std::size_t kTreeFrom = 64;
+// Large rings cut ears of a worse shape (2 · area / longest side², ~ the smallest angle's sine)
+// only when no other ear is left.
+constexpr double kThinEar = 1e-3;
 
 struct Node {
   double x = 0.0, y = 0.0;
@@ -476,10 +479,13 @@ class Triangulator {
   // neighbours at the back (their older entries go stale), so each corner is tested once plus
   // twice per cut, and the cuts go round the ring (every other corner, then every other of the
   // rest, ...) instead of fanning from one corner. In a simple ring a cut changes no other
-  // corner's ear status (a triangle holding a corner holds a reflex one); when the queue runs
-  // dry (degenerate input) one ring walk finds a loose ear or the most convex corner.
+  // corner's ear status (a triangle holding a corner holds a reflex one), except where corners
+  // lie on another's ear (collinear runs): when the queue runs dry every corner is tested again,
+  // and when that finds no ear either, one ring walk finds a loose ear or the most convex corner.
   void clip_queued(std::int32_t start, std::size_t count) {
-    std::deque<std::pair<std::int32_t, std::uint32_t>> queue;  // node, its stamp when queued
+    // Corners to test, and ears too thin to cut while other ears remain (a sliver there would
+    // round to nothing in a float STL and open the stack).
+    std::deque<std::pair<std::int32_t, std::uint32_t>> queue, thin;  // node, its stamp when queued
     std::vector<std::uint32_t> stamp(nodes.size(), 0);
     const auto requeue = [&](std::int32_t q) { queue.emplace_back(q, ++stamp[static_cast<std::size_t>(q)]); };
     std::int32_t p = start;
@@ -488,33 +494,61 @@ class Triangulator {
       p = at(p).next;
     } while (p != start);
     std::int32_t last = start;  // a corner still in the ring
+    bool retested = false;      // every corner re-queued since the last cut
     while (count > 3) {
       if (steps > budget) {
         last = cut_rest(last, count);
         break;
       }
-      if (queue.empty()) {
+      if (queue.empty() && thin.empty()) {
+        // Dry: a corner on the boundary of another's ear (collinear runs, touching rings) can
+        // stop blocking it without being its neighbour. Test them all once more, as a walk would;
+        // when that finds nothing either, force a cut.
+        if (!retested) {
+          for (p = at(last).next; p != last; p = at(p).next) requeue(p);
+          requeue(last);
+          retested = true;
+          continue;
+        }
         last = cut_without_strict_ear(last);
         --count;
         requeue(last);
         requeue(at(last).prev);
+        retested = false;
         continue;
       }
-      const auto [e, queued] = queue.front();
-      queue.pop_front();
+      const bool from_thin = queue.empty();
+      auto& from = from_thin ? thin : queue;
+      const auto [e, queued] = from.front();
+      from.pop_front();
       ++steps;
       if (!alive[static_cast<std::size_t>(e)] || queued != stamp[static_cast<std::size_t>(e)]) continue;
       const std::int32_t prev = at(e).prev, next = at(e).next;
       const bool copy = at(e).index == at(next).index;  // two copies of one vertex in a row: no triangle
       if (!copy && !same_point(e, next) && !is_ear(e, true)) continue;
+      if (!copy && !from_thin && shape(prev, e, next) < kThinEar) {
+        thin.emplace_back(e, queued);
+        continue;
+      }
       if (!copy) emit(prev, e, next);
       remove(e);
       --count;
       requeue(prev);
       requeue(next);
       last = next;
+      retested = false;
     }
     if (count == 3) emit(at(last).prev, last, at(last).next);
+  }
+
+  // 2 · area / (longest side)², about the sine of the triangle's smallest angle.
+  double shape(std::int32_t a, std::int32_t b, std::int32_t c) const {
+    const auto d2 = [this](std::int32_t p, std::int32_t q) {
+      const double dx = at(q).x - at(p).x, dy = at(q).y - at(p).y;
+      return dx * dx + dy * dy;
+    };
+    const double longest = std::max({d2(a, b), d2(b, c), d2(c, a)});
+    return longest > 0.0 ? orient(a, b, c) / longest : 0.0;
   }
 
   // No strict ear left: the first loose ear from `from` on, else the most convex corner, is cut.
