@@ -22,9 +22,10 @@ namespace {
 
 // Polygons from this many vertices on get trees for their ear tests.
 constexpr std::size_t kTreeFrom = 64;
-// Large rings cut ears of a worse shape (2 · area / longest side², ~ the smallest angle's sine)
-// only when no other ear is left.
-constexpr double kThinEar = 1e-3;
+// Large rings cut an ear lower than this many float steps of the ring's coordinates (its
+// height over its longest side) only when no other ear is left: stack.stl stores float, and
+// rounding would flatten it to a sliver with no area, opening the stack.
+constexpr double kThinEarFloatSteps = 64.0;
 
 struct Node {
   double x = 0.0, y = 0.0;
@@ -161,6 +162,7 @@ class Triangulator {
   bool use_trees = false;
   std::uint64_t steps = 0, budget = 0;
   bool exhausted = false;
+  double thin_height = 0.0;  // see kThinEarFloatSteps
 
   // Links ring vertices first..first+n−1 (numbered from `first_index`) in the wanted
   // orientation; returns a node of the ring.
@@ -341,12 +343,15 @@ class Triangulator {
   void start_clipping(std::int32_t start, std::size_t count) {
     alive.assign(nodes.size(), 0);
     std::vector<std::int32_t> reflex;
+    double magnitude = 0.0;
     std::int32_t p = start;
     do {
       alive[static_cast<std::size_t>(p)] = 1;
       if (orient(at(p).prev, p, at(p).next) <= 0.0) reflex.push_back(p);
+      magnitude = std::max({magnitude, std::abs(at(p).x), std::abs(at(p).y)});
       p = at(p).next;
     } while (p != start);
+    thin_height = kThinEarFloatSteps * magnitude * std::numeric_limits<float>::epsilon();
     // A simple ring costs a few dozen steps a vertex; this leaves room for hard ones, not for
     // self-intersecting rings that defeat the trees and would cost n² steps.
     budget = (std::uint64_t{1} << 20) + 32 * std::uint64_t{count} * std::bit_width(count);
@@ -483,8 +488,7 @@ class Triangulator {
   // lie on another's ear (collinear runs): when the queue runs dry every corner is tested again,
   // and when that finds no ear either, one ring walk finds a loose ear or the most convex corner.
   void clip_queued(std::int32_t start, std::size_t count) {
-    // Corners to test, and ears too thin to cut while other ears remain (a sliver there would
-    // round to nothing in a float STL and open the stack).
+    // Corners to test, and ears too thin to cut while other ears remain (kThinEarFloatSteps).
     std::deque<std::pair<std::int32_t, std::uint32_t>> queue, thin;  // node, its stamp when queued
     std::vector<std::uint32_t> stamp(nodes.size(), 0);
     const auto requeue = [&](std::int32_t q) { queue.emplace_back(q, ++stamp[static_cast<std::size_t>(q)]); };
@@ -526,7 +530,7 @@ class Triangulator {
       const std::int32_t prev = at(e).prev, next = at(e).next;
       const bool copy = at(e).index == at(next).index;  // two copies of one vertex in a row: no triangle
       if (!copy && !same_point(e, next) && !is_ear(e, true)) continue;
-      if (!copy && !from_thin && shape(prev, e, next) < kThinEar) {
+      if (!copy && !from_thin && height(prev, e, next) < thin_height) {
         thin.emplace_back(e, queued);
         continue;
       }
@@ -541,13 +545,13 @@ class Triangulator {
     if (count == 3) emit(at(last).prev, last, at(last).next);
   }
 
-  // 2 · area / (longest side)², about the sine of the triangle's smallest angle.
-  double shape(std::int32_t a, std::int32_t b, std::int32_t c) const {
+  // The triangle's height over its longest side.
+  double height(std::int32_t a, std::int32_t b, std::int32_t c) const {
     const auto d2 = [this](std::int32_t p, std::int32_t q) {
       const double dx = at(q).x - at(p).x, dy = at(q).y - at(p).y;
       return dx * dx + dy * dy;
     };
-    const double longest = std::max({d2(a, b), d2(b, c), d2(c, a)});
+    const double longest = std::sqrt(std::max({d2(a, b), d2(b, c), d2(c, a)}));
     return longest > 0.0 ? orient(a, b, c) / longest : 0.0;
   }
 
