@@ -6,8 +6,9 @@
 // only at the corners that are not convex, through a 2-d tree they leave once convex or cut: in a
 // simple polygon a triangle holding any vertex holds a reflex one, and cutting an ear never makes
 // a convex corner reflex. After each cut the walk skips a corner, so the triangles stay local
-// rather than fanning out from one corner (a fan's long triangles cover many corners' boxes). A
-// step budget bounds what degenerate input can cost: past it the rest is cut corner by corner.
+// rather than fanning out from one corner (a fan's long triangles cover many corners' boxes), and
+// ears too low for float wait until nothing else is left. A step budget bounds what degenerate
+// input can cost: past it the rest is cut corner by corner.
 #include "polygon_triangulation.hpp"
 
 #include <algorithm>
