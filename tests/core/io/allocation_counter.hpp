@@ -10,8 +10,7 @@ class AllocationScope {
  public:
   AllocationScope();
   ~AllocationScope();
-  AllocationScope(const AllocationScope&) = delete;
-  AllocationScope& operator=(const AllocationScope&) = delete;
+  AllocationScope(AllocationScope&&) = delete;  // nor copied: one scope, open while it lives
 
   std::size_t total_bytes() const;  // every allocation since the scope opened, freed or not
   std::size_t peak_bytes() const;   // the most held at once, above what was held when it opened
