@@ -11,6 +11,7 @@ const char* error_code_name(ErrorCode code) {
     case ErrorCode::empty_mesh: return "empty_mesh";
     case ErrorCode::invalid_argument: return "invalid_argument";
     case ErrorCode::unsupported: return "unsupported";
+    case ErrorCode::limit_exceeded: return "limit_exceeded";
   }
   return "unknown";
 }

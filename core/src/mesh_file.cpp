@@ -95,7 +95,8 @@ std::expected<Bytes, Error> read_whole(InputFile& file, std::span<const std::byt
 
 // Binary STL, converted chunk by chunk. `chunk` holds the first `have` bytes of the file.
 std::expected<TriangleSoup, Error> stream_binary_stl(InputFile& file, std::byte* chunk, std::size_t have,
-                                                     std::uint32_t count, const std::string& name) {
+                                                     std::uint32_t count, const std::string& name,
+                                                     const detail::FileQuote& quote) {
   using detail::kStlPreambleBytes;
   using detail::kStlTriangleBytes;
   detail::StlBinaryDecoder decoder(count);
@@ -110,12 +111,12 @@ std::expected<TriangleSoup, Error> stream_binary_stl(InputFile& file, std::byte*
     if (!got) return std::unexpected(got.error());
     if (*got == 0) {  // the file shrank after fstat
       return std::unexpected(detail::stl_short_binary_error(
-          name, count, kStlPreambleBytes + kStlTriangleBytes * decoder.decoded() + leftover));
+          name, count, kStlPreambleBytes + kStlTriangleBytes * decoder.decoded() + leftover, quote));
     }
     have = leftover + *got;
     offset = 0;
   }
-  return std::move(decoder).finish(name, file.size());
+  return std::move(decoder).finish(name, file.size(), quote);
 }
 
 std::string lower_extension(const std::filesystem::path& path) {
@@ -144,10 +145,11 @@ bool looks_like_obj(std::string_view text) {
 }
 
 // Content that is not STL: say what it is when we can tell.
-std::expected<TriangleSoup, Error> not_stl(const Bytes& all, Error stl_error, const std::string& name) {
+std::expected<TriangleSoup, Error> not_stl(const Bytes& all, Error stl_error, const std::string& name,
+                                           const MeshReadOptions& options) {
   const std::string_view text = all.text();
   if (text.starts_with("PK\x03\x04")) {  // a zip: perhaps a 3MF under another name
-    auto three_mf = parse_3mf(all.span(), name);
+    auto three_mf = parse_3mf(all.span(), name, options);
     if (three_mf || three_mf.error().code != ErrorCode::unknown_format) return three_mf;
     return std::unexpected(Error{ErrorCode::unknown_format,
                                  fmt::format("{} (a zip archive, but not STL, OBJ or 3MF)", three_mf.error().message)});
@@ -157,14 +159,14 @@ std::expected<TriangleSoup, Error> not_stl(const Bytes& all, Error stl_error, co
                                  fmt::format("{}: a PLY file, which is not read (convert it to STL or OBJ)", name)});
   }
   if (stl_error.code == ErrorCode::unknown_format && looks_like_obj(text.substr(0, 4096))) {
-    return parse_obj(text, name);
+    return parse_obj(text, name, options);
   }
   return std::unexpected(std::move(stl_error));
 }
 
 }  // namespace
 
-std::expected<TriangleSoup, Error> read_mesh_file(const std::filesystem::path& path) {
+std::expected<TriangleSoup, Error> read_mesh_file(const std::filesystem::path& path, const MeshReadOptions& options) {
   const std::string name = path.string();
   auto file = InputFile::open(path, name);
   if (!file) return std::unexpected(std::move(file.error()));
@@ -173,7 +175,7 @@ std::expected<TriangleSoup, Error> read_mesh_file(const std::filesystem::path& p
   if (ext == ".obj" || ext == ".3mf") {
     auto all = read_whole(*file, {});
     if (!all) return std::unexpected(std::move(all.error()));
-    return ext == ".obj" ? parse_obj(all->text(), name) : parse_3mf(all->span(), name);
+    return ext == ".obj" ? parse_obj(all->text(), name, options) : parse_3mf(all->span(), name, options);
   }
 
   // STL by content: the first chunk and the size tell binary from ASCII.
@@ -182,15 +184,16 @@ std::expected<TriangleSoup, Error> read_mesh_file(const std::filesystem::path& p
   if (!first) return std::unexpected(std::move(first.error()));
   const detail::StlProbe probe = detail::probe_stl({chunk.get(), *first}, file->size());
   if (!probe.ascii_like && probe.binary_fits && probe.declared > 0) {
-    return stream_binary_stl(*file, chunk.get(), *first, static_cast<std::uint32_t>(probe.declared), name);
+    return stream_binary_stl(*file, chunk.get(), *first, static_cast<std::uint32_t>(probe.declared), name,
+                             detail::FileQuote(options.quote_file_text));
   }
 
   auto all = read_whole(*file, {chunk.get(), *first});
   if (!all) return std::unexpected(std::move(all.error()));
   chunk.reset();
-  auto stl = parse_stl(all->span(), name);
+  auto stl = parse_stl(all->span(), name, options);
   if (stl) return stl;
-  return not_stl(*all, std::move(stl.error()), name);
+  return not_stl(*all, std::move(stl.error()), name, options);
 }
 
 }  // namespace lamina

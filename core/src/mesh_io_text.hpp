@@ -1,6 +1,8 @@
 #pragma once
 // Private helpers shared by the text readers (ASCII STL, OBJ): character classes, keyword
 // comparison, number parsing with std::from_chars, and quoting of offending input in messages.
+#include <fmt/format.h>
+
 #include <charconv>
 #include <cstddef>
 #include <cstdint>
@@ -94,5 +96,33 @@ inline std::string quote_excerpt(std::string_view s, std::size_t max_chars = 40)
   out += "'";
   return out;
 }
+
+// How a reader's messages show the file's own bytes (MeshReadOptions::quote_file_text). Quoting
+// off, a message keeps where and what was expected and says only how long the bytes were: a
+// client must not be able to read a file through the errors of a reader pointed at it.
+class FileQuote {
+ public:
+  explicit FileQuote(bool quote) : quote_(quote) {}
+
+  bool quoting() const { return quote_; }
+
+  // A piece of the file: an excerpt in quotes, or e.g. "a token of 7 bytes" for noun "a token".
+  std::string text(std::string_view s, std::string_view noun) const {
+    if (quote_) return quote_excerpt(s);
+    return fmt::format("{} of {} byte{}", noun, s.size(), s.size() == 1 ? "" : "s");
+  }
+
+  // A value stored in the file, to follow its noun: " 12", or nothing ("vertex index{} is ...").
+  template <class T>
+  std::string value(const T& v) const {
+    return quote_ ? fmt::format(" {}", v) : std::string();
+  }
+
+  // `s` formatted (it holds file values) when quoting, else `neutral`.
+  std::string either(std::string s, std::string_view neutral) const { return quote_ ? std::move(s) : std::string(neutral); }
+
+ private:
+  bool quote_;
+};
 
 }  // namespace lamina::detail

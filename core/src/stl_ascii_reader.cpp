@@ -15,8 +15,8 @@ namespace {
 
 class Scanner {
  public:
-  Scanner(std::string_view text, std::string_view name)
-      : p_(text.data()), end_(text.data() + text.size()), name_(name) {
+  Scanner(std::string_view text, std::string_view name, const FileQuote& quote)
+      : p_(text.data()), end_(text.data() + text.size()), name_(name), quote_(quote) {
     if (text.starts_with("\xEF\xBB\xBF")) p_ += 3;
   }
 
@@ -101,7 +101,8 @@ class Scanner {
                                                        name_, line_, expected)};
     }
     return Error{ErrorCode::parse_error,
-                 fmt::format("{}:{}: ASCII STL: expected {}, found {}", name_, line_, expected, quote_excerpt(tok))};
+                 fmt::format("{}:{}: ASCII STL: expected {}, found {}", name_, line_, expected,
+                             quote_.text(tok, "a token"))};
   }
 
   // True when only whitespace and NUL padding remain.
@@ -120,6 +121,7 @@ class Scanner {
   const char* p_;
   const char* end_;
   std::string_view name_;
+  FileQuote quote_;
   std::size_t line_ = 1;
 };
 
@@ -128,15 +130,27 @@ struct Solid {
   std::size_t facets = 0;
 };
 
+// "'a' 12 facets, 'b' 3 facets" (names only when quoting: they are the file's text).
+std::string solid_list(const std::vector<Solid>& solids, const FileQuote& quote) {
+  std::string parts;
+  for (const Solid& s : solids) {
+    if (!parts.empty()) parts += ", ";
+    if (quote.quoting()) parts += fmt::format("'{}' ", s.name);
+    parts += fmt::format("{} facets", s.facets);
+  }
+  return parts;
+}
+
 }  // namespace
 
-std::expected<TriangleSoup, Error> parse_stl_ascii(std::string_view text, std::string_view name) {
+std::expected<TriangleSoup, Error> parse_stl_ascii(std::string_view text, std::string_view name,
+                                                   const FileQuote& quote) {
   TriangleSoup soup;
   soup.format = "stl-ascii";
   // A facet takes at least ~ 100 bytes of text; reserving from that avoids most regrowth.
   soup.corners.reserve(3 * (text.size() / 128 + 1));
 
-  Scanner in(text, name);
+  Scanner in(text, name, quote);
   StlNormalStats normals;
   std::size_t non_finite = 0;
   std::size_t non_finite_triangles = 0;
@@ -197,15 +211,10 @@ std::expected<TriangleSoup, Error> parse_stl_ascii(std::string_view text, std::s
                                                           name, in.line(), solids.back().facets)});
   }
   if (solids.size() > 1) {
-    std::string parts;
-    for (const Solid& s : solids) {
-      if (!parts.empty()) parts += ", ";
-      parts += fmt::format("'{}' {} facets", s.name, s.facets);
-    }
     soup.notes.push_back(
-        {"multiple_solids", fmt::format("{}: {} solid blocks: {}", name, solids.size(), parts)});
+        {"multiple_solids", fmt::format("{}: {} solid blocks: {}", name, solids.size(), solid_list(solids, quote))});
   }
-  normals.append_notes(soup.notes, name);
+  normals.append_notes(soup.notes, name, quote);
   append_non_finite_note(soup.notes, name, non_finite, non_finite_triangles);
   return soup;
 }

@@ -60,7 +60,7 @@ void StlBinaryDecoder::decode(const std::byte* p, std::size_t n) {
   non_finite_triangles_ += non_finite_triangles;
 }
 
-TriangleSoup StlBinaryDecoder::finish(std::string_view name, std::uint64_t file_size) && {
+TriangleSoup StlBinaryDecoder::finish(std::string_view name, std::uint64_t file_size, const FileQuote& quote) && {
   const std::uint64_t used = kStlPreambleBytes + kStlTriangleBytes * std::uint64_t{count_};
   if (file_size > used) {
     const std::uint64_t extra = file_size - used;
@@ -69,12 +69,13 @@ TriangleSoup StlBinaryDecoder::finish(std::string_view name, std::uint64_t file_
                                        "expected, {} present)",
                                        name, extra, extra == 1 ? "" : "s", count_, used, file_size)});
   }
-  normals_.append_notes(soup_.notes, name);
+  normals_.append_notes(soup_.notes, name, quote);
   append_non_finite_note(soup_.notes, name, non_finite_, non_finite_triangles_);
   return std::move(soup_);
 }
 
-std::expected<TriangleSoup, Error> parse_stl_binary(std::span<const std::byte> bytes, std::string_view name) {
+std::expected<TriangleSoup, Error> parse_stl_binary(std::span<const std::byte> bytes, std::string_view name,
+                                                    const FileQuote& quote) {
   const std::uint32_t count = read_count(bytes);
   if (count == 0) {
     return std::unexpected(Error{ErrorCode::empty_mesh,
@@ -83,7 +84,7 @@ std::expected<TriangleSoup, Error> parse_stl_binary(std::span<const std::byte> b
   }
   StlBinaryDecoder decoder(count);
   decoder.decode(bytes.data() + kStlPreambleBytes, count);
-  return std::move(decoder).finish(name, bytes.size());
+  return std::move(decoder).finish(name, bytes.size(), quote);
 }
 
 }  // namespace lamina::detail

@@ -4,6 +4,7 @@
 // and the stored-normal statistics both formats note.
 #include "lamina/core/error.hpp"
 #include "lamina/core/triangle_soup.hpp"
+#include "mesh_io_text.hpp"
 
 #include <cmath>
 #include <cstddef>
@@ -44,8 +45,9 @@ struct StlNormalStats {
     }
   }
 
-  // Appends "stored_normals_zero" (every normal zero) or "stored_normals_not_unit" notes.
-  void append_notes(std::vector<ReadNote>& notes, std::string_view name) const;
+  // Appends "stored_normals_zero" (every normal zero) or "stored_normals_not_unit" notes (with
+  // the range of lengths only when quoting: they are the file's values).
+  void append_notes(std::vector<ReadNote>& notes, std::string_view name, const FileQuote& quote) const;
 };
 
 // Count of float coordinates that are NaN or infinite (kept as they are; noted once).
@@ -79,7 +81,7 @@ class StlBinaryDecoder {
   std::size_t decoded() const { return done_; }
 
   // Notes (trailing bytes past the records, stored normals, non-finite values) and the soup.
-  TriangleSoup finish(std::string_view name, std::uint64_t file_size) &&;
+  TriangleSoup finish(std::string_view name, std::uint64_t file_size, const FileQuote& quote) &&;
 
  private:
   TriangleSoup soup_;
@@ -91,12 +93,15 @@ class StlBinaryDecoder {
 };
 
 // The error for a binary STL shorter than its count says (an implausible count says "not STL").
-Error stl_short_binary_error(std::string_view name, std::uint64_t declared, std::uint64_t size);
+// The count is the file's bytes 80-83: named only when quoting.
+Error stl_short_binary_error(std::string_view name, std::uint64_t declared, std::uint64_t size, const FileQuote& quote);
 
 // `bytes` holds at least 84 + 50·n bytes (n = the count at byte 80, > 0).
-std::expected<TriangleSoup, Error> parse_stl_binary(std::span<const std::byte> bytes, std::string_view name);
+std::expected<TriangleSoup, Error> parse_stl_binary(std::span<const std::byte> bytes, std::string_view name,
+                                                    const FileQuote& quote);
 
 // `text` starts (after optional whitespace / BOM) with the keyword "solid".
-std::expected<TriangleSoup, Error> parse_stl_ascii(std::string_view text, std::string_view name);
+std::expected<TriangleSoup, Error> parse_stl_ascii(std::string_view text, std::string_view name,
+                                                   const FileQuote& quote);
 
 }  // namespace lamina::detail

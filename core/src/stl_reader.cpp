@@ -53,7 +53,8 @@ bool starts_with_solid_keyword(std::string_view text) {
 
 namespace detail {
 
-void StlNormalStats::append_notes(std::vector<ReadNote>& notes, std::string_view name) const {
+void StlNormalStats::append_notes(std::vector<ReadNote>& notes, std::string_view name,
+                                  const FileQuote& quote) const {
   if (count == 0) return;
   if (zero == count) {
     notes.push_back({"stored_normals_zero",
@@ -62,8 +63,9 @@ void StlNormalStats::append_notes(std::vector<ReadNote>& notes, std::string_view
     return;
   }
   if (not_unit > 0 || zero > 0) {
-    const std::string lengths =
-        not_unit > 0 ? fmt::format(", lengths {:.3g} to {:.3g}", min_length, max_length) : std::string();
+    const std::string lengths = not_unit > 0 && quote.quoting()
+                                    ? fmt::format(", lengths {:.3g} to {:.3g}", min_length, max_length)
+                                    : std::string();
     notes.push_back({"stored_normals_not_unit",
                      fmt::format("{}: {} of {} stored facet normals are not unit length ({} zero{}); normals come "
                                  "from the winding",
@@ -83,19 +85,26 @@ StlProbe probe_stl(std::span<const std::byte> prefix, std::uint64_t size) {
   return probe;
 }
 
-Error stl_short_binary_error(std::string_view name, std::uint64_t declared, std::uint64_t size) {
+Error stl_short_binary_error(std::string_view name, std::uint64_t declared, std::uint64_t size,
+                             const FileQuote& quote) {
   const std::uint64_t needed = kStlPreambleBytes + kStlTriangleBytes * declared;
+  // The count is bytes 80-83 of the file: without quoting, only that it is too large.
+  const std::string count = quote.either(fmt::format("{} triangles ({} bytes)", declared, needed),
+                                         "more triangles (its count at byte 80)");
+  const std::string in_file = quote.either(fmt::format("in a file of {} bytes", size),
+                                           fmt::format("than a file of {} bytes holds", size));
   if (declared > kImplausibleTriangles) {
     return Error{ErrorCode::unknown_format,
-                 fmt::format("{}: not an STL file: not text, and read as binary STL it would declare {} triangles "
-                             "({} bytes) in a file of {} bytes",
-                             name, declared, needed, size)};
+                 fmt::format("{}: not an STL file: not text, and read as binary STL it would declare {} {}", name,
+                             count, in_file)};
   }
   const std::uint64_t complete = size < kStlPreambleBytes ? 0 : (size - kStlPreambleBytes) / kStlTriangleBytes;
+  const std::string has = quote.either(fmt::format("but the file has {} bytes", size),
+                                       fmt::format("than the file's {} bytes hold", size));
   return Error{ErrorCode::truncated_file,
-               fmt::format("{}: binary STL declares {} triangles ({} bytes) but the file has {} bytes: {} complete "
-                           "triangles present (truncated, or not an STL file)",
-                           name, declared, needed, size, complete)};
+               fmt::format("{}: binary STL declares {} {}: {} complete triangles present (truncated, or not an STL "
+                           "file)",
+                           name, count, has, complete)};
 }
 
 void append_non_finite_note(std::vector<ReadNote>& notes, std::string_view name, std::size_t non_finite_values,
@@ -108,25 +117,27 @@ void append_non_finite_note(std::vector<ReadNote>& notes, std::string_view name,
 
 }  // namespace detail
 
-std::expected<TriangleSoup, Error> parse_stl(std::span<const std::byte> bytes, std::string_view name) {
+std::expected<TriangleSoup, Error> parse_stl(std::span<const std::byte> bytes, std::string_view name,
+                                             const MeshReadOptions& options) {
+  const detail::FileQuote quote(options.quote_file_text);
   const std::size_t size = bytes.size();
   if (size == 0) return std::unexpected(Error{ErrorCode::empty_mesh, fmt::format("{}: the file is empty", name)});
 
   const std::string_view text(reinterpret_cast<const char*>(bytes.data()), size);
   const detail::StlProbe probe = detail::probe_stl(bytes, size);
   if (probe.ascii_like) {
-    auto ascii = detail::parse_stl_ascii(text, name);
+    auto ascii = detail::parse_stl_ascii(text, name, quote);
     // A text-looking header whose size still matches a binary layout: trust the size.
     if (ascii || !probe.binary_fits) return ascii;
-    return detail::parse_stl_binary(bytes, name);
+    return detail::parse_stl_binary(bytes, name, quote);
   }
-  if (probe.binary_fits) return detail::parse_stl_binary(bytes, name);
+  if (probe.binary_fits) return detail::parse_stl_binary(bytes, name, quote);
 
   if (probe.text_prefix) {
+    const std::string start =
+        quote.either(fmt::format(" (starts with {})", detail::quote_excerpt(skip_bom_and_space(text).substr(0, 24))), "");
     return std::unexpected(Error{
-        ErrorCode::unknown_format,
-        fmt::format("{}: not an STL file: text that does not start with 'solid' (starts with {})", name,
-                    detail::quote_excerpt(skip_bom_and_space(text).substr(0, 24)))});
+        ErrorCode::unknown_format, fmt::format("{}: not an STL file: text that does not start with 'solid'{}", name, start)});
   }
   if (size < detail::kStlPreambleBytes) {
     return std::unexpected(
@@ -135,7 +146,7 @@ std::expected<TriangleSoup, Error> parse_stl(std::span<const std::byte> bytes, s
                           "and it is not ASCII STL",
                           name, size)});
   }
-  return std::unexpected(detail::stl_short_binary_error(name, probe.declared, size));
+  return std::unexpected(detail::stl_short_binary_error(name, probe.declared, size, quote));
 }
 
 }  // namespace lamina

@@ -25,7 +25,9 @@ MeshParams mesh_params_from(const ModelOptions& o) {
 std::expected<LoadedModel, Error> load_model(const ModelOptions& options) {
   LoadedModel out;
   auto t0 = std::chrono::steady_clock::now();
-  auto soup = read_mesh_file(options.path);
+  MeshReadOptions read_options;
+  read_options.quote_file_text = !options.no_quote_input;
+  auto soup = read_mesh_file(options.path, read_options);
   out.read_s = seconds_since(t0);
   if (!soup) return std::unexpected(soup.error());
   out.format = soup->format;

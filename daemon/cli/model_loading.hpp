@@ -15,6 +15,9 @@ struct ModelOptions {
   std::vector<double> direction;  // or any vector (3 numbers); replaces axis when given
   double sharp_angle_deg = 30.0;
   double weld_tolerance_rel = 1e-7;
+  // --no-quote-input: reader messages describe the file's bytes instead of quoting them (laminad
+  // plans files its clients name; MeshReadOptions::quote_file_text).
+  bool no_quote_input = false;
 };
 
 struct LoadedModel {

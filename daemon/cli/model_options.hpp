@@ -22,6 +22,9 @@ inline void add_model_options(CLI::App& cmd, ModelOptions& o) {
   cmd.add_option("--weld-tolerance", o.weld_tolerance_rel, "Vertex weld distance, fraction of the bounding-box diagonal")
       ->check(CLI::Range(0.0, 1e-2))
       ->capture_default_str();
+  cmd.add_flag("--no-quote-input", o.no_quote_input,
+               "Errors and notes about MODEL say where and what was expected but never quote its bytes "
+               "(for a file someone else named: laminad passes it)");
 }
 
 }  // namespace lamina::cli

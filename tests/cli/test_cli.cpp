@@ -80,6 +80,34 @@ TEST(Cli, BrokenFilesGiveAnErrorNamingTheProblem) {
   fs::remove(truncated);
 }
 
+TEST(Cli, NoQuoteInputKeepsAFilesBytesOutOfTheErrors) {
+  // What laminad passes for a file its client named (issue 16, item 9): a reader error must say
+  // where and what, but never show the file's bytes, here a first line and an ASCII STL token.
+  const fs::path secret = temp_file("secret.stl");
+  const fs::path token = temp_file("token.stl");
+  {
+    std::ofstream(secret, std::ios::binary) << "root:Kj7Q-secret-hash:19000:0:99999:7:::\n";
+    std::ofstream(token, std::ios::binary) << "solid x\nfacet normal Kj7Q-secret-hash 0 0\n";
+  }
+  for (const fs::path& file : {secret, token}) {
+    for (const std::string& cmd : {"check " + quoted(file), "slice " + quoted(file) + " --step 1",
+                                   "plan " + quoted(file) + " --out " + quoted(temp_file("plan-out"))}) {
+      const CliRun quoting = lamina(cmd);
+      EXPECT_EQ(quoting.exit_code, 1) << cmd << "\n" << quoting.out;
+      EXPECT_NE(quoting.out.find("Kj7Q-secret-hash"), std::string::npos) << cmd << "\n" << quoting.out;
+      const CliRun neutral = lamina(cmd + " --no-quote-input");
+      EXPECT_EQ(neutral.exit_code, 1) << cmd << "\n" << neutral.out;
+      EXPECT_NE(neutral.out.find("error ["), std::string::npos) << cmd << "\n" << neutral.out;
+      EXPECT_EQ(neutral.out.find("Kj7Q"), std::string::npos) << cmd << "\n" << neutral.out;
+    }
+  }
+  for (const char* cmd : {"check", "slice", "plan"})
+    EXPECT_NE(lamina(std::string(cmd) + " --help").out.find("--no-quote-input"), std::string::npos) << cmd;
+  fs::remove(secret);
+  fs::remove(token);
+  fs::remove_all(temp_file("plan-out"));
+}
+
 TEST(Cli, UsageErrorsAreRejected) {
   EXPECT_NE(lamina("slice " + quoted(kKnob)).exit_code, 0) << "a height option is required";
   EXPECT_NE(lamina("slice " + quoted(kKnob) + " --step 1 --at 2").exit_code, 0) << "options exclude each other";

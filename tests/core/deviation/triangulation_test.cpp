@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <map>
 #include <numbers>
@@ -201,6 +202,53 @@ TEST(Triangulation, LongCollinearSidesWithTheGrid) {
   std::vector<Polygon2> holes;
   for (int k = 0; k < 8; ++k) holes.push_back(reversed(rect(2 + 12 * k, 2, 10 + 12 * k, 8)));
   expect_tiling(outer, holes, "long rectangle with holes");
+}
+
+
+// Rings of 20,000 vertices (issue 16, item 12): the ear tests of large rings look only at reflex
+// corners near the ear, so the work (counted, not timed) stays about n log n where testing every
+// corner was n² (a 100,000-vertex ring: 127 ms at 10,000 → seconds at 100,000).
+TEST(Triangulation, LargeRingsTileInAboutLinearWork) {
+  const int n = 20000;
+  Polygon2 circle, star, spiral_in, spiral_out, comb{{0.0, -1.0}, {5000.0, -1.0}};
+  for (int i = 0; i < n; ++i) {
+    const double a = 2 * std::numbers::pi * i / n;
+    circle.emplace_back(std::cos(a), std::sin(a));
+    star.push_back((i % 2 == 1 ? 0.5 : 1.0) * circle.back());
+    const double t = 8 * std::numbers::pi * i / n;
+    spiral_in.emplace_back((1.0 + t) * std::cos(t), (1.0 + t) * std::sin(t));
+    spiral_out.emplace_back((1.5 + t) * std::cos(t), (1.5 + t) * std::sin(t));
+  }
+  for (int k = 4999; k >= 0; --k)
+    for (const auto& p : {Eigen::Vector2d(k + 0.5, 0), Eigen::Vector2d(k + 0.5, 10), Eigen::Vector2d(k, 10),
+                          Eigen::Vector2d(k, 0)})
+      comb.push_back(p);
+  Polygon2 spiral(spiral_in.begin(), spiral_in.end());
+  spiral.insert(spiral.end(), spiral_out.rbegin(), spiral_out.rend());
+  if (signed_area_mm2(spiral) < 0) spiral = reversed(spiral);
+  for (const auto& [what, ring] : {std::pair{"circle", circle}, {"star", star}, {"spiral", spiral}, {"comb", comb}}) {
+    detail::TriangulationWork work;
+    const Tris tris = triangulate_polygon_with_holes(ring, {}, detail::kCapStraightSine, &work);
+    EXPECT_FALSE(work.exhausted) << what;
+    EXPECT_LT(work.steps, 20 * ring.size() * std::bit_width(ring.size())) << what << ": " << work.steps / ring.size();
+    expect_tiling(ring, {}, what);
+  }
+}
+
+TEST(Triangulation, ASelfCrossingLargeRingStaysBoundedAndClosed) {
+  // Random points in random order: no proper ears. The step budget ends the search and the
+  // rest is cut corner by corner: still n − 2 triangles on every boundary edge once.
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  Polygon2 noise;
+  for (int i = 0; i < 20000; ++i) noise.emplace_back(u(rng), u(rng));
+  if (signed_area_mm2(noise) < 0) noise = reversed(noise);  // as given, so the edges read the same way
+  detail::TriangulationWork work;
+  const Tris tris = triangulate_polygon_with_holes(noise, {}, detail::kCapStraightSine, &work);
+  EXPECT_EQ(tris.size(), noise.size() - 2);
+  EXPECT_TRUE(work.exhausted);
+  EXPECT_LT(work.steps, (std::uint64_t{1} << 20) + 33 * noise.size() * std::bit_width(noise.size()));
+  EXPECT_EQ(edge_problem(noise, {}, tris), "");
 }
 
 }  // namespace

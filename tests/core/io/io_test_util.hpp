@@ -139,6 +139,45 @@ inline std::vector<std::byte> make_zip(const std::vector<ZipItem>& items) {
   return out;
 }
 
+// --- 3MF packages: the parts a 3MF zip holds. -------------------------------------------------
+
+inline const std::string kContentTypes =
+    R"(<?xml version="1.0" encoding="UTF-8"?>
+<Types xmlns="http://schemas.openxmlformats.org/package/2006/content-types">
+ <Default Extension="rels" ContentType="application/vnd.openxmlformats-package.relationships+xml"/>
+ <Default Extension="model" ContentType="application/vnd.ms-package.3dmanufacturing-3dmodel+xml"/>
+</Types>
+)";
+
+inline std::string rels(std::string_view target) {
+  return std::string(R"(<?xml version="1.0" encoding="UTF-8"?>
+<Relationships xmlns="http://schemas.openxmlformats.org/package/2006/relationships">
+ <Relationship Target=")") +
+         std::string(target) +
+         R"(" Id="rel0" Type="http://schemas.microsoft.com/3dmanufacturing/2013/01/3dmodel"/>
+</Relationships>
+)";
+}
+
+// Line 1: declaration, line 2: <model>, line 3: <resources>, then `resources` from line 4.
+inline std::string model(std::string_view resources, std::string_view build, std::string_view unit = "millimeter") {
+  return std::string("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<model unit=\"") + std::string(unit) +
+         "\" xmlns=\"http://schemas.microsoft.com/3dmanufacturing/core/2015/02\">\n<resources>\n" +
+         std::string(resources) + "</resources>\n<build>\n" + std::string(build) + "</build>\n</model>\n";
+}
+
+// Object 1: one triangle.
+inline const std::string kTriangleObject =
+    "<object id=\"1\" type=\"model\"><mesh><vertices>\n"
+    "<vertex x=\"0\" y=\"0\" z=\"0\"/><vertex x=\"1\" y=\"0\" z=\"0\"/><vertex x=\"0\" y=\"1\" z=\"0\"/>\n"
+    "</vertices><triangles><triangle v1=\"0\" v2=\"1\" v3=\"2\"/></triangles></mesh></object>\n";
+
+// Content types, relationships naming `path`, and the model part there (all stored).
+inline std::vector<std::byte> package(const std::string& model_xml, std::string_view path = "3D/3dmodel.model") {
+  return make_zip({stored("[Content_Types].xml", kContentTypes), stored("_rels/.rels", rels("/" + std::string(path))),
+                   stored(std::string(path), model_xml)});
+}
+
 inline std::span<const std::byte> as_bytes(std::string_view s) {
   return {reinterpret_cast<const std::byte*>(s.data()), s.size()};
 }

@@ -18,40 +18,12 @@ using test::stored;
 using test::TempDir;
 using test::ZipItem;
 
-const std::string kContentTypes =
-    R"(<?xml version="1.0" encoding="UTF-8"?>
-<Types xmlns="http://schemas.openxmlformats.org/package/2006/content-types">
- <Default Extension="rels" ContentType="application/vnd.openxmlformats-package.relationships+xml"/>
- <Default Extension="model" ContentType="application/vnd.ms-package.3dmanufacturing-3dmodel+xml"/>
-</Types>
-)";
+using test::kContentTypes;
+using test::model;
+using test::package;
+using test::rels;
 
-std::string rels(std::string_view target) {
-  return std::string(R"(<?xml version="1.0" encoding="UTF-8"?>
-<Relationships xmlns="http://schemas.openxmlformats.org/package/2006/relationships">
- <Relationship Target=")") +
-         std::string(target) +
-         R"(" Id="rel0" Type="http://schemas.microsoft.com/3dmanufacturing/2013/01/3dmodel"/>
-</Relationships>
-)";
-}
-
-// Line 1: declaration, line 2: <model>, line 3: <resources>, then `resources` from line 4.
-std::string model(std::string_view resources, std::string_view build, std::string_view unit = "millimeter") {
-  return std::string("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<model unit=\"") + std::string(unit) +
-         "\" xmlns=\"http://schemas.microsoft.com/3dmanufacturing/core/2015/02\">\n<resources>\n" +
-         std::string(resources) + "</resources>\n<build>\n" + std::string(build) + "</build>\n</model>\n";
-}
-
-std::vector<std::byte> package(const std::string& model_xml, std::string_view path = "3D/3dmodel.model") {
-  return make_zip({stored("[Content_Types].xml", kContentTypes), stored("_rels/.rels", rels("/" + std::string(path))),
-                   stored(std::string(path), model_xml)});
-}
-
-const std::string kTriangleObject =
-    "<object id=\"1\" type=\"model\"><mesh><vertices>\n"
-    "<vertex x=\"0\" y=\"0\" z=\"0\"/><vertex x=\"1\" y=\"0\" z=\"0\"/><vertex x=\"0\" y=\"1\" z=\"0\"/>\n"
-    "</vertices><triangles><triangle v1=\"0\" v2=\"1\" v3=\"2\"/></triangles></mesh></object>\n";
+using test::kTriangleObject;
 
 // `translate([1,2,3]) cube([10,20,30]);` exported by OpenSCAD 2021.01 (lib3mf 1.8.1, Debian
 // bookworm): lib3mf writes ZIP64 end records and ZIP64 extra fields, and namespaced attributes.

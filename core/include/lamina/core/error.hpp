@@ -14,6 +14,7 @@ enum class ErrorCode : std::uint16_t {
   empty_mesh = 5,        // no usable facet
   invalid_argument = 6,  // a parameter outside its domain
   unsupported = 7,       // a valid file using a feature we do not read
+  limit_exceeded = 8,    // a file asking for more than a read limit allows (MeshReadOptions)
 };
 
 // Stable lower-case name of a code, e.g. "truncated_file".
