@@ -142,7 +142,9 @@ std::expected<nlohmann::json, PlanProcessError> run_plan_process(const PlanProce
   } closer{progress_pipe};
 
   std::vector<std::string> args{r.lamina.string(), "plan", r.model.string(), "--out", r.out_dir.string(), "--json",
-                                "--progress-fd", std::to_string(kProgressFd)};
+                                "--progress-fd", std::to_string(kProgressFd),
+                                // A client named the file: its bytes stay out of job.error and the log.
+                                "--no-quote-input"};
   args.insert(args.end(), r.flags.begin(), r.flags.end());
   std::vector<char*> argv;
   for (auto& a : args) argv.push_back(a.data());

@@ -100,6 +100,16 @@ TEST(LaminadProtocol, ASubmitReadsNoFileOutsideTheRoots) {
       << stock.error().message;
   EXPECT_TRUE(call_ok(c, "job.list").empty()) << "no job was made of a refused file";
   EXPECT_EQ(daemon.log().find("TOP-SECRET"), std::string::npos);
+
+  // Inside a root, a file that is no model fails its job, and the reader's message describes
+  // the bytes instead of quoting them (lamina plan --no-quote-input).
+  std::filesystem::create_directories(cell.dir.file("parts"));
+  std::ofstream(cell.dir.file("parts/notes.stl")) << "solid TOP-SECRET-BYTES\nfacet TOP-SECRET-2 nonsense\n";
+  const Json job = call_ok(c, "job.submit", {{"model", cell.dir.file("parts/notes.stl")}});
+  const Json failed = wait_state(c, job["id"], "failed", 60);
+  ASSERT_EQ(failed["state"], "failed") << failed.dump(2);
+  EXPECT_EQ(failed["error"].get<std::string>().find("TOP-SECRET"), std::string::npos) << failed["error"];
+  EXPECT_EQ(daemon.log().find("TOP-SECRET"), std::string::npos);
 }
 
 // Issue 16, item 10: a submit with a mistyped setting used the upload up and left its file;
