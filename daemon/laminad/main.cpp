@@ -63,6 +63,39 @@ void every(boost::asio::steady_timer& timer, std::chrono::milliseconds period, F
   });
 }
 
+// The state directory's jobs/ (an error when it cannot be made) and the parts folder: the
+// default one is ours to make; a configured one is the shop's (only noted when missing).
+bool prepare_folders(const DaemonConfig& config) {
+  std::error_code ec;
+  fs::create_directories(config.state_dir / "jobs", ec);
+  if (ec) {
+    spdlog::error("state directory {}: {}", config.state_dir.string(), ec.message());
+    return false;
+  }
+  for (const fs::path root : config.jobs.roots) {
+    if (root == config.state_dir / "parts") fs::create_directories(root, ec);
+    if (!fs::is_directory(root, ec)) spdlog::warn("[jobs] roots: {} is not a folder; no model can be named there", root.string());
+  }
+  return true;
+}
+
+RpcServerSettings server_settings(const ServerConfig& server) {
+  RpcServerSettings rs;
+  rs.unix_path = server.socket_path;
+  rs.unix_mode = server.socket_mode;
+  rs.unix_group = server.socket_group;
+  rs.tcp_host = server.tcp_host;
+  rs.tcp_port = server.tcp_port;
+  rs.token = server.token;
+  rs.max_request_bytes = server.max_request_bytes;
+  rs.max_clients = server.max_clients;
+  rs.idle_timeout_s = server.idle_timeout_s;
+  rs.pre_auth_timeout_s = server.pre_auth_timeout_s;
+  // The operator's stop buttons jump every queue (and server.subscribe touches its own client).
+  rs.inline_methods = {"machine.hold", "machine.abort", "server.subscribe", "server.info"};
+  return rs;
+}
+
 int run(const fs::path& config_path, bool check_only) {
   auto config = load_daemon_config(config_path);
   if (!config) {
@@ -75,17 +108,7 @@ int run(const fs::path& config_path, bool check_only) {
   }
   config->planner.lamina_path = find_lamina(config->planner.lamina_path).string();
 
-  std::error_code ec;
-  fs::create_directories(config->state_dir / "jobs", ec);
-  if (ec) {
-    spdlog::error("state directory {}: {}", config->state_dir.string(), ec.message());
-    return 1;
-  }
-  // The default parts folder is ours to make; a configured one is the shop's (only noted).
-  for (const fs::path root : config->jobs.roots) {
-    if (root == config->state_dir / "parts") fs::create_directories(root, ec);
-    if (!fs::is_directory(root, ec)) spdlog::warn("[jobs] roots: {} is not a folder; no model can be named there", root.string());
-  }
+  if (!prepare_folders(*config)) return 1;
   auto store = JobStore::open(config->state_dir / "lamina.db");
   if (!store) {
     spdlog::error("{}", store.error().message);
@@ -110,19 +133,7 @@ int run(const fs::path& config_path, bool check_only) {
   // Caught from here on: a SIGTERM during start-up (systemd stopping a unit it just started) is
   // queued until the handler below is waiting, not the default action that kills us mid-write.
   boost::asio::signal_set signals(io, SIGTERM, SIGINT);
-  RpcServerSettings rs;
-  rs.unix_path = config->server.socket_path;
-  rs.unix_mode = config->server.socket_mode;
-  rs.unix_group = config->server.socket_group;
-  rs.tcp_host = config->server.tcp_host;
-  rs.tcp_port = config->server.tcp_port;
-  rs.token = config->server.token;
-  rs.max_request_bytes = config->server.max_request_bytes;
-  rs.max_clients = config->server.max_clients;
-  rs.idle_timeout_s = config->server.idle_timeout_s;
-  rs.pre_auth_timeout_s = config->server.pre_auth_timeout_s;
-  // The operator's stop buttons jump every queue (and server.subscribe touches its own client).
-  rs.inline_methods = {"machine.hold", "machine.abort", "server.subscribe", "server.info"};
+  RpcServerSettings rs = server_settings(config->server);
 
   // Socket activation: laminad.socket hands over the Unix listener; TCP (if any) is ours to open.
   std::vector<int> activated;

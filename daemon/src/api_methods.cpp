@@ -46,20 +46,8 @@ RpcResult job_result(std::expected<JobRecord, RpcError> r) {
   return to_json(*r);
 }
 
-}  // namespace
-
-RpcServer::Handler make_api_handler(JobManager& jobs, Uploads& uploads, ServerInfo info) {
-  auto methods = std::make_shared<std::map<std::string, Method>>();
-  auto& m = *methods;
-
-  m["server.info"] = [info](const Json&, ClientContext&) -> RpcResult {
-    return Json{{"name", "laminad"}, {"version", info.version}, {"machine", info.machine}, {"state_dir", info.state_dir},
-                {"api", 1}};
-  };
-  m["server.subscribe"] = [](const Json&, ClientContext& client) -> RpcResult {
-    client.subscribed = true;
-    return Json{{"subscribed", true}, {"notifications", {"notify_job_progress", "notify_machine_status"}}};
-  };
+// upload.begin / chunk / cancel: a model sent in pieces (uploads.hpp).
+void add_upload_methods(std::map<std::string, Method>& m, Uploads& uploads) {
   m["upload.begin"] = [&uploads](const Json& params, ClientContext&) -> RpcResult {
     auto p = object_params(params);
     if (!p) return std::unexpected(p.error());
@@ -92,6 +80,23 @@ RpcServer::Handler make_api_handler(JobManager& jobs, Uploads& uploads, ServerIn
     if (auto r = uploads.cancel(*id); !r) return std::unexpected(r.error());
     return Json{{"cancelled", *id}};
   };
+}
+
+}  // namespace
+
+RpcServer::Handler make_api_handler(JobManager& jobs, Uploads& uploads, ServerInfo info) {
+  auto methods = std::make_shared<std::map<std::string, Method>>();
+  auto& m = *methods;
+
+  m["server.info"] = [info](const Json&, ClientContext&) -> RpcResult {
+    return Json{{"name", "laminad"}, {"version", info.version}, {"machine", info.machine}, {"state_dir", info.state_dir},
+                {"api", 1}};
+  };
+  m["server.subscribe"] = [](const Json&, ClientContext& client) -> RpcResult {
+    client.subscribed = true;
+    return Json{{"subscribed", true}, {"notifications", {"notify_job_progress", "notify_machine_status"}}};
+  };
+  add_upload_methods(m, uploads);
   m["job.submit"] = [&jobs, &uploads](const Json& params, ClientContext&) -> RpcResult {
     auto p = object_params(params);
     if (!p) return std::unexpected(p.error());

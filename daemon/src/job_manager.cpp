@@ -458,6 +458,40 @@ void JobManager::planner_loop() {
   }
 }
 
+// report.json's sheets and summary into the job (under mutex_); false when it has no sheet.
+bool JobManager::take_plan(JobRecord& job, const nlohmann::json& r) {
+  job.sheets.clear();
+  std::size_t lines = 0;
+  double estimate_s = 0;
+  for (const auto& s : r.value("sheets", nlohmann::json::array())) {
+    SheetRecord sheet;
+    sheet.index = s.value("index", 0);
+    sheet.program_path = (fs::path(job.artefact_dir) / s.value("program", "")).string();
+    sheet.svg_path = (fs::path(job.artefact_dir) / s.value("svg", "")).string();
+    sheet.material = s.value("material", "");
+    sheet.thickness_mm = s.value("thickness_mm", 0.0);
+    std::ifstream in(sheet.program_path);
+    for (std::string line; std::getline(in, line);) sheet.lines_total += !line.empty() && line != "\r";
+    lines += sheet.lines_total;
+    estimate_s += s.value("estimated_time_s", 0.0);
+    job.sheets.push_back(std::move(sheet));
+  }
+  if (job.sheets.empty()) return false;
+  nlohmann::json deviation = nlohmann::json::object();
+  const nlohmann::json deviations = r.value("deviation", nlohmann::json::object());  // named: items() keeps a reference
+  for (const auto& [strategy, d] : deviations.items())
+    deviation[strategy] = {{"volume_pct", d.value("volume_pct", 0.0)}, {"max_mm", d.value("max_mm", 0.0)}};
+  job.summary = {{"layers", r.contains("layers") ? r["layers"].size() : 0},
+                 {"sheets", job.sheets.size()},
+                 {"lines", lines},
+                 {"estimated_cut_s", estimate_s},
+                 {"deviation", deviation},
+                 {"stack", (fs::path(job.artefact_dir) / "stack.stl").string()},
+                 {"report", (fs::path(job.artefact_dir) / "report.json").string()},
+                 {"warnings", r.value("warnings", nlohmann::json::array())}};
+  return true;
+}
+
 void JobManager::plan_job(const std::string& id) {
   auto cancel = std::make_shared<std::atomic<bool>>(false);
   PlanProcessRequest request;
@@ -504,39 +538,10 @@ void JobManager::plan_job(const std::string& id) {
     (void)set_state(*job, report.error().cancelled ? JobState::cancelled : JobState::failed, report.error().message);
     return;
   }
-  const nlohmann::json& r = *report;
-  job->sheets.clear();
-  std::size_t lines = 0;
-  double estimate_s = 0;
-  for (const auto& s : r.value("sheets", nlohmann::json::array())) {
-    SheetRecord sheet;
-    sheet.index = s.value("index", 0);
-    sheet.program_path = (fs::path(job->artefact_dir) / s.value("program", "")).string();
-    sheet.svg_path = (fs::path(job->artefact_dir) / s.value("svg", "")).string();
-    sheet.material = s.value("material", "");
-    sheet.thickness_mm = s.value("thickness_mm", 0.0);
-    std::ifstream in(sheet.program_path);
-    for (std::string line; std::getline(in, line);) sheet.lines_total += !line.empty() && line != "\r";
-    lines += sheet.lines_total;
-    estimate_s += s.value("estimated_time_s", 0.0);
-    job->sheets.push_back(std::move(sheet));
-  }
-  if (job->sheets.empty()) {
+  if (!take_plan(*job, *report)) {
     (void)set_state(*job, JobState::failed, "the plan has no sheets to cut (see plan.log)");
     return;
   }
-  nlohmann::json deviation = nlohmann::json::object();
-  const nlohmann::json deviations = r.value("deviation", nlohmann::json::object());  // named: items() keeps a reference
-  for (const auto& [strategy, d] : deviations.items())
-    deviation[strategy] = {{"volume_pct", d.value("volume_pct", 0.0)}, {"max_mm", d.value("max_mm", 0.0)}};
-  job->summary = {{"layers", r.contains("layers") ? r["layers"].size() : 0},
-                  {"sheets", job->sheets.size()},
-                  {"lines", lines},
-                  {"estimated_cut_s", estimate_s},
-                  {"deviation", deviation},
-                  {"stack", (fs::path(job->artefact_dir) / "stack.stl").string()},
-                  {"report", (fs::path(job->artefact_dir) / "report.json").string()},
-                  {"warnings", r.value("warnings", nlohmann::json::array())}};
   (void)set_state(*job, JobState::planned);
   assign_machine();
 }

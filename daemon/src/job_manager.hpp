@@ -89,6 +89,7 @@ class JobManager {
   // --- threads ---
   void planner_loop();
   void plan_job(const std::string& id);
+  bool take_plan(JobRecord& job, const nlohmann::json& report);
   void cut_sheet(std::string job_id, int sheet, CutStart how, std::vector<std::string> program,
                  std::optional<std::size_t> resume_line);
   void finish_cut(const std::string& job_id, int sheet, const drivers::CutReport& report);
