@@ -126,6 +126,7 @@ struct ModbusServer::Impl {
   modbus_mapping_t* mapping = nullptr;
   int wake[2] = {-1, -1};  // self-pipe: the destructor writes a byte, select wakes at once
   std::atomic<bool> stopping{false};
+  std::atomic<bool> network_up{true};
   std::atomic<std::size_t> served{0};
   std::vector<Client> clients;
   std::thread thread;
@@ -175,6 +176,10 @@ struct ModbusServer::Impl {
 
   void run() {
     while (!stopping) {
+      if (!network_up) {
+        cut_off();
+        continue;
+      }
       fd_set readable;
       FD_ZERO(&readable);
       FD_SET(listen_fd, &readable);
@@ -202,6 +207,19 @@ struct ModbusServer::Impl {
       std::erase_if(clients, [](const Client& c) { return c.fd < 0; });
       if (FD_ISSET(listen_fd, &readable)) accept_one();
     }
+  }
+
+  // The PLC off the network (a cable pulled, a switch down): its logic runs on, the heartbeat
+  // watchdog included, but no request is answered. Connections it had are gone; new ones wait
+  // unaccepted in the backlog, so a host sees timeouts, as behind a dead link.
+  void cut_off() {
+    for (auto& c : clients) drop(c);
+    clients.clear();
+    fd_set readable;
+    FD_ZERO(&readable);
+    FD_SET(wake[0], &readable);
+    timeval timeout{0, 50'000};
+    if (::select(wake[0] + 1, &readable, nullptr, nullptr, &timeout) > 0 && FD_ISSET(wake[0], &readable)) stopping = true;
   }
 
   void accept_one() {
@@ -293,5 +311,7 @@ ModbusServer::~ModbusServer() = default;
 
 int ModbusServer::port() const { return impl_->port; }
 std::size_t ModbusServer::requests_served() const { return impl_->served; }
+void ModbusServer::set_network_up(bool up) { impl_->network_up = up; }
+bool ModbusServer::network_up() const { return impl_->network_up; }
 
 }  // namespace lamina::sim

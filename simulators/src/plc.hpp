@@ -55,6 +55,8 @@ struct CncButtons {
 class Plc {
  public:
   explicit Plc(PlcConfig config);
+  // The watchdog's timeout in simulated seconds (lamina-sim rescales it with the time scale).
+  void set_heartbeat_timeout_s(double s) { config_.heartbeat_timeout_s = s; }
 
   // Called after every Modbus write (the server passes the image it wrote into): latches
   // alarm_reset, counts heartbeat changes, takes a new mailbox sequence number.

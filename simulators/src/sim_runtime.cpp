@@ -59,7 +59,8 @@ const char* on_open_name(OnOpen o) {
 
 SimRuntime::SimRuntime(SimOptions options)
     : options_(std::move(options)),
-      start_(std::chrono::steady_clock::now()),
+      clock_(options_.time_scale),
+      heartbeat_timeout_wall_s_(options_.plc.heartbeat_timeout_s / options_.time_scale),
       machine_(options_.machine),
       rx_pacer_(options_.baud / 10.0, kBurstS),
       tx_pacer_(options_.baud / 10.0, kBurstS),
@@ -96,10 +97,6 @@ SimRuntime::SimRuntime(SimOptions options)
 
 SimRuntime::~SimRuntime() = default;
 
-double SimRuntime::wall_s() const {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-}
-
 nlohmann::json SimRuntime::ready_info() const {
   nlohmann::json info{{"ready", true}, {"personality", options_.personality}};
   if (!options_.link_path.empty()) info["link"] = options_.link_path;
@@ -127,7 +124,7 @@ void SimRuntime::run(const std::atomic<bool>& stop) {
 
 void SimRuntime::step() {
   const double wall = wall_s();
-  const double now = wall * options_.time_scale;
+  const double now = clock_.sim_at(wall);
 
   switch (port_->update()) {
     case PortChange::client_connected:
@@ -379,6 +376,7 @@ nlohmann::json SimRuntime::status_json() const {
   nlohmann::json pos = nlohmann::json::array();
   for (double v : machine_.position(now)) pos.push_back(v);
   return {{"t", now},
+          {"time_scale", clock_.scale()},
           {"state", state_name(machine_.state())},
           {"position", pos},
           {"accepted_blocks", machine_.accepted_blocks()},
@@ -422,6 +420,21 @@ std::string SimRuntime::handle_command(const std::string& line) {
     if (verb == "pressure" && (arg == "drop" || arg == "restore"))
       return plc_fault([&] { plc_.set_pressure_drop(arg == "drop"); },
                        arg == "drop" ? "pressure_drop" : "pressure_restore");
+    if (verb == "time-scale") {
+      const double k = std::stod(arg);
+      if (!(k > 0 && k <= 1000)) return "error: time-scale K needs a factor in (0, 1000]";
+      log_.write_event("time_scale", now, {{"from", clock_.scale()}, {"to", k}});
+      clock_.set_scale(k);
+      std::lock_guard lock(plc_mutex_);
+      plc_.set_heartbeat_timeout_s(heartbeat_timeout_wall_s_ * k);
+      return "ok";
+    }
+    if (verb == "plc" && (arg == "down" || arg == "up")) {
+      if (!modbus_) return "error: plc down|up needs the PLC (--modbus)";
+      modbus_->set_network_up(arg == "up");
+      log_.write_event(arg == "up" ? "plc_up" : "plc_down", now, {{"source", "control"}});
+      return "ok";
+    }
     if (verb == "stall") {
       const double ms = std::stod(arg);
       if (!(ms > 0)) return "error: stall MS needs a positive number of milliseconds";
@@ -464,7 +477,7 @@ std::string SimRuntime::handle_command(const std::string& line) {
     return fmt::format("error: '{}' needs a number, got '{}'", verb, arg);
   }
   return fmt::format("error: unknown command '{}' (status, estop on|off, door open|closed, pressure drop|restore, "
-                     "stall MS, lag MS, unplug, replug, alarm N, reset, garble P)", line);
+                     "plc down|up, time-scale K, stall MS, lag MS, unplug, replug, alarm N, reset, garble P)", line);
 }
 
 }  // namespace lamina::sim

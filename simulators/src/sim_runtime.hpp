@@ -21,6 +21,7 @@
 #include "machine.hpp"
 #include "modbus_server.hpp"
 #include "plc.hpp"
+#include "sim_clock.hpp"
 #include "sim_options.hpp"
 
 namespace lamina::sim {
@@ -35,8 +36,8 @@ class SimRuntime {
   void run(const std::atomic<bool>& stop);
 
  private:
-  double wall_s() const;
-  double sim_s() const { return wall_s() * options_.time_scale; }
+  double wall_s() const { return clock_.wall_s(); }
+  double sim_s() const { return clock_.sim_s(); }
   void step();
   void move_bytes_in(double wall, double now);
   void move_bytes_out(double wall);
@@ -53,7 +54,8 @@ class SimRuntime {
   nlohmann::json status_json() const;
 
   SimOptions options_;
-  std::chrono::steady_clock::time_point start_;
+  SimClock clock_;
+  double heartbeat_timeout_wall_s_;  // the PLC's watchdog in wall seconds, whatever the scale
   Machine machine_;
   std::unique_ptr<CncProtocol> protocol_;
   std::unique_ptr<CncPort> port_;

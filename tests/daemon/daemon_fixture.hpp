@@ -3,7 +3,12 @@
 // and the daemon as separate processes, a config written per test, clients over the socket.
 #include <signal.h>
 #include <spawn.h>
+#include <sys/mount.h>
 #include <sys/wait.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
 
 #include <algorithm>
 #include <chrono>
@@ -231,6 +236,37 @@ inline void expect_resumed_at_the_cut_short_contour(const std::vector<std::strin
   for (std::size_t i = 0; i < lines.size() - contour_start; ++i)
     ASSERT_EQ(log[resumed_at + i].line, lines[contour_start + i]) << "resumed block " << i + 1;
 }
+
+// A small tmpfs over a folder: a disk that really fills up. Needs CAP_SYS_ADMIN (root on the CI
+// machine); without it the test says so and skips.
+class SmallDisk {
+ public:
+  SmallDisk(const std::string& folder, const std::string& size) : folder_(folder) {
+    std::filesystem::create_directories(folder);
+    const std::string options = "size=" + size + ",mode=0755";
+    mounted_ = ::mount("tmpfs", folder.c_str(), "tmpfs", 0, options.c_str()) == 0;
+    if (!mounted_) why_ = std::strerror(errno);
+  }
+  ~SmallDisk() {
+    if (mounted_) ::umount2(folder_.c_str(), MNT_DETACH);
+  }
+  bool mounted() const { return mounted_; }
+  const std::string& why() const { return why_; }
+  // Writes a file until the disk is full; its size.
+  std::size_t fill(const std::string& name) const {
+    std::FILE* f = std::fopen((folder_ + "/" + name).c_str(), "wb");
+    if (!f) return 0;
+    const std::string block(64 * 1024, 'x');
+    std::size_t written = 0;
+    while (std::fwrite(block.data(), 1, block.size(), f) == block.size()) written += block.size();
+    std::fclose(f);
+    return written;
+  }
+
+ private:
+  std::string folder_, why_;
+  bool mounted_ = false;
+};
 
 // The example knob submitted on 5 mm stock, planned, its first sheet confirmed, and the CNC past
 // `blocks_before` executed blocks; the job's id.

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 
+#include "campaign_checks.hpp"
 #include "daemon_fixture.hpp"
 #include "modbus_test_client.hpp"
 
@@ -59,6 +60,74 @@ TEST_P(LaminadRecovery, KilledWhileCuttingComesBackInterruptedAndResumesOnReques
 }
 
 INSTANTIATE_TEST_SUITE_P(OnOpen, LaminadRecovery, ::testing::Values("banner", "reset"));
+
+// Block records of the simulator's log as they are written (flushed per record): read what was
+// appended since the last look, whole lines only.
+class LogTail {
+ public:
+  explicit LogTail(std::string path) : path_(std::move(path)) {}
+  // The number of block records so far, and the line of the last one.
+  std::size_t blocks() {
+    std::ifstream in(path_, std::ios::binary);
+    in.seekg(static_cast<std::streamoff>(offset_));
+    std::string chunk((std::istreambuf_iterator<char>(in)), {});
+    std::size_t start = 0;
+    for (std::size_t nl; (nl = chunk.find('\n', start)) != std::string::npos; start = nl + 1) {
+      const Json r = Json::parse(chunk.substr(start, nl - start));
+      if (r.contains("seq") && !r.contains("event")) {
+        ++blocks_;
+        last_ = r.value("line", "");
+      }
+    }
+    offset_ += start;
+    return blocks_;
+  }
+  const std::string& last() const { return last_; }
+
+ private:
+  std::string path_;
+  std::size_t offset_ = 0, blocks_ = 0;
+  std::string last_;
+};
+
+// Issue 16, item 5: kill -9 just after a contour's last cut. The resume line used to be capped
+// by the saved acknowledged line, up to 200 ms old, which lay in the finished contour: it was cut
+// twice (2 of 2 tries). Now the CNC's executed count places it; the campaign's oracle checks that
+// no contour is cut twice, none skipped, none left dry.
+TEST(LaminadRecoveryAtAContourEnd, KilledJustAfterAContourFinishedCutsEveryContourOnce) {
+  Cell cell({}, 40);
+  auto daemon = std::make_unique<Laminad>(cell.config(), cell.dir.file(""));
+  RpcClient c = connect(cell.socket());
+  const std::string id = start_cutting(c, cell, 0);
+  const auto lines = program_lines(call_ok(c, "job.get", {{"job", id}})["sheets"][0]["program"]);
+  // The last cutting move of the fourth contour: the line before its M5.
+  std::vector<std::size_t> markers;
+  for (std::size_t i = 0; i < lines.size(); ++i)
+    if (lines[i].rfind("(CONTOUR ", 0) == 0) markers.push_back(i);
+  ASSERT_GT(markers.size(), 5u);
+  std::size_t last_cut = markers[4];
+  while (last_cut > markers[3] && lines[last_cut] != "M5") --last_cut;
+  ASSERT_GT(last_cut, markers[3]) << "no M5 in contour 4";
+  --last_cut;
+  LogTail tail(cell.log());
+  const auto t0 = std::chrono::steady_clock::now();
+  while (tail.blocks() <= last_cut && seconds_since(t0) < 120) std::this_thread::sleep_for(std::chrono::microseconds(500));
+  EXPECT_EQ(daemon->stop(SIGKILL), -SIGKILL);
+  ASSERT_GT(tail.blocks(), last_cut) << "the cut never got there";
+  ASSERT_TRUE(sim::testing::wait_status(cell.sim.control_port(), [](const Json& s) { return s["state"] == "hold"; }, 30));
+
+  daemon->start();
+  c = connect(cell.socket());
+  ASSERT_EQ(call_ok(c, "job.get", {{"job", id}})["state"], "interrupted");
+  call_ok(c, "job.resume", {{"job", id}});
+  const Json job = wait_job(c, id, [](const Json& j) { return j["state"] != "cutting"; }, 300);
+  ASSERT_EQ(job["sheets"][0]["state"], "done") << job.dump(2) << daemon->log();
+  const auto log = campaign::parse_machine_log(sim::testing::read_log(cell.log()));
+  const auto check = campaign::check_contours_cut_once(lines, log, true);
+  EXPECT_TRUE(check.violations.empty()) << check.violations.front();
+  EXPECT_EQ(check.finished, check.contours);
+  EXPECT_EQ(check.passes, 2u);
+}
 
 TEST(LaminadShutdown, SigtermWhileCuttingLeavesTheCellSafeAndTheJobInterrupted) {
   Cell cell({}, 40);

@@ -4,12 +4,6 @@
 // a restart with room on the disk the sheet resumes with every finished contour cut once.
 #include <gtest/gtest.h>
 
-#include <sys/mount.h>
-
-#include <cerrno>
-#include <cstdio>
-#include <cstring>
-
 #include "daemon_fixture.hpp"
 #include "modbus_test_client.hpp"
 
@@ -17,37 +11,6 @@ namespace lamina::daemon::testing {
 namespace {
 
 const std::string kModel = std::string(LAMINA_EXAMPLES_DIR) + "/knob.stl";
-
-// A small tmpfs over a folder: a disk that really fills up. Needs CAP_SYS_ADMIN (root on the CI
-// machine); without it the test says so and skips.
-class SmallDisk {
- public:
-  SmallDisk(const std::string& folder, const std::string& size) : folder_(folder) {
-    std::filesystem::create_directories(folder);
-    const std::string options = "size=" + size + ",mode=0755";
-    mounted_ = ::mount("tmpfs", folder.c_str(), "tmpfs", 0, options.c_str()) == 0;
-    if (!mounted_) why_ = std::strerror(errno);
-  }
-  ~SmallDisk() {
-    if (mounted_) ::umount2(folder_.c_str(), MNT_DETACH);
-  }
-  bool mounted() const { return mounted_; }
-  const std::string& why() const { return why_; }
-  // Writes a file until the disk is full; its size.
-  std::size_t fill(const std::string& name) const {
-    std::FILE* f = std::fopen((folder_ + "/" + name).c_str(), "wb");
-    if (!f) return 0;
-    const std::string block(64 * 1024, 'x');
-    std::size_t written = 0;
-    while (std::fwrite(block.data(), 1, block.size(), f) == block.size()) written += block.size();
-    std::fclose(f);
-    return written;
-  }
-
- private:
-  std::string folder_, why_;
-  bool mounted_ = false;
-};
 
 Json machine_status(RpcClient& c) { return call_ok(c, "machine.status"); }
 
