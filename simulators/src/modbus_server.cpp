@@ -127,6 +127,7 @@ struct ModbusServer::Impl {
   int wake[2] = {-1, -1};  // self-pipe: the destructor writes a byte, select wakes at once
   std::atomic<bool> stopping{false};
   std::atomic<bool> network_up{true};
+  std::atomic<bool> network_applied{true};  // what the server thread has acted on
   std::atomic<std::size_t> served{0};
   std::vector<Client> clients;
   std::thread thread;
@@ -161,10 +162,7 @@ struct ModbusServer::Impl {
 
   ~Impl() {
     stopping = true;
-    if (wake[1] >= 0) {
-      const char byte = 1;
-      [[maybe_unused]] auto n = ::write(wake[1], &byte, 1);
-    }
+    if (wake[1] >= 0) wake_up();
     if (thread.joinable()) thread.join();
     for (auto& c : clients) drop(c);
     if (listen_fd >= 0) ::close(listen_fd);
@@ -180,6 +178,7 @@ struct ModbusServer::Impl {
         cut_off();
         continue;
       }
+      network_applied = true;
       fd_set readable;
       FD_ZERO(&readable);
       FD_SET(listen_fd, &readable);
@@ -201,7 +200,10 @@ struct ModbusServer::Impl {
       if (n < 0) {
         FD_ZERO(&readable);  // EINTR: contents undefined
       }
-      if (FD_ISSET(wake[0], &readable)) break;
+      if (FD_ISSET(wake[0], &readable)) {
+        drain_wake();
+        continue;  // stopping, or the network went down: the loop's head decides
+      }
       for (auto& c : clients)
         if ((c.partial_since || FD_ISSET(c.fd, &readable)) && !serve(c)) drop(c);
       std::erase_if(clients, [](const Client& c) { return c.fd < 0; });
@@ -218,8 +220,27 @@ struct ModbusServer::Impl {
     fd_set readable;
     FD_ZERO(&readable);
     FD_SET(wake[0], &readable);
+    network_applied = false;
     timeval timeout{0, 50'000};
-    if (::select(wake[0] + 1, &readable, nullptr, nullptr, &timeout) > 0 && FD_ISSET(wake[0], &readable)) stopping = true;
+    if (::select(wake[0] + 1, &readable, nullptr, nullptr, &timeout) > 0 && FD_ISSET(wake[0], &readable)) drain_wake();
+  }
+
+  void drain_wake() {
+    char bytes[16];
+    while (::read(wake[0], bytes, sizeof bytes) > 0) {
+    }
+  }
+
+  void wake_up() {
+    const char byte = 1;
+    [[maybe_unused]] auto n = ::write(wake[1], &byte, 1);
+  }
+
+  // Returns once the server thread has acted on the change (a request after it sees it).
+  void set_network(bool up) {
+    network_up = up;
+    wake_up();
+    for (int i = 0; i < 1000 && network_applied != up; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(1));
   }
 
   void accept_one() {
@@ -311,7 +332,7 @@ ModbusServer::~ModbusServer() = default;
 
 int ModbusServer::port() const { return impl_->port; }
 std::size_t ModbusServer::requests_served() const { return impl_->served; }
-void ModbusServer::set_network_up(bool up) { impl_->network_up = up; }
+void ModbusServer::set_network_up(bool up) { impl_->set_network(up); }
 bool ModbusServer::network_up() const { return impl_->network_up; }
 
 }  // namespace lamina::sim

@@ -55,8 +55,13 @@ struct CncButtons {
 class Plc {
  public:
   explicit Plc(PlcConfig config);
-  // The watchdog's timeout in simulated seconds (lamina-sim rescales it with the time scale).
-  void set_heartbeat_timeout_s(double s) { config_.heartbeat_timeout_s = s; }
+  // The simulated clock now runs `factor` times as fast against the wall (control `time-scale`):
+  // the watchdog, which supervises a wall-clock host, keeps its wall timeout and the heartbeat's
+  // wall age. Without the age, a slowdown would make a fresh heartbeat look stale.
+  void rescale_watchdog(double now_s, double factor) {
+    config_.heartbeat_timeout_s *= factor;
+    last_heartbeat_s_ = now_s - (now_s - last_heartbeat_s_) * factor;
+  }
 
   // Called after every Modbus write (the server passes the image it wrote into): latches
   // alarm_reset, counts heartbeat changes, takes a new mailbox sequence number.

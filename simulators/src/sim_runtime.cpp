@@ -60,7 +60,6 @@ const char* on_open_name(OnOpen o) {
 SimRuntime::SimRuntime(SimOptions options)
     : options_(std::move(options)),
       clock_(options_.time_scale),
-      heartbeat_timeout_wall_s_(options_.plc.heartbeat_timeout_s / options_.time_scale),
       machine_(options_.machine),
       rx_pacer_(options_.baud / 10.0, kBurstS),
       tx_pacer_(options_.baud / 10.0, kBurstS),
@@ -423,10 +422,11 @@ std::string SimRuntime::handle_command(const std::string& line) {
     if (verb == "time-scale") {
       const double k = std::stod(arg);
       if (!(k > 0 && k <= 1000)) return "error: time-scale K needs a factor in (0, 1000]";
-      log_.write_event("time_scale", now, {{"from", clock_.scale()}, {"to", k}});
-      clock_.set_scale(k);
+      const double from = clock_.scale();
+      log_.write_event("time_scale", now, {{"from", from}, {"to", k}});
       std::lock_guard lock(plc_mutex_);
-      plc_.set_heartbeat_timeout_s(heartbeat_timeout_wall_s_ * k);
+      clock_.set_scale(k);
+      plc_.rescale_watchdog(now, k / from);
       return "ok";
     }
     if (verb == "plc" && (arg == "down" || arg == "up")) {

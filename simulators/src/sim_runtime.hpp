@@ -55,7 +55,6 @@ class SimRuntime {
 
   SimOptions options_;
   SimClock clock_;
-  double heartbeat_timeout_wall_s_;  // the PLC's watchdog in wall seconds, whatever the scale
   Machine machine_;
   std::unique_ptr<CncProtocol> protocol_;
   std::unique_ptr<CncPort> port_;

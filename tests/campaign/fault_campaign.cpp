@@ -86,6 +86,11 @@ const std::vector<Fault>& faults() {
          r.daemon->start();
          r.reconnect();
        }},
+      // Not a fault but the operator's hold: the jet must go off once the machine stands, and
+      // the resume re-opens it in the kerf before the motion.
+      {"hold", false, [](Rig& r, Rng&) { call_ok(r.c(), "machine.hold"); }, [](Rig&, Rng& rng) {
+         std::this_thread::sleep_for(std::chrono::duration<double>(uniform(rng, 0.2, 2.0)));
+       }},
       {"unplug", false, [](Rig& r, Rng&) { r.control("unplug"); },
        [](Rig& r, Rng& rng) {
          std::this_thread::sleep_for(std::chrono::duration<double>(uniform(rng, 0.1, 2.0)));
@@ -158,8 +163,12 @@ void expect_stopped(Rig& r, const std::string& id, bool daemon_alive, RunRecord&
     return;
   }
   if (daemon_alive) {
-    const Json job = wait_job(r.c(), id, [](const Json& j) { return j["state"] != "cutting"; }, 60);
-    if (job["state"] == "cutting") rec.violations.push_back("the job still says cutting 60 s after the fault");
+    // A job whose store failed may still read "cutting": that is what its database holds, and
+    // what clients see is never ahead of it (machine.status says the store failed).
+    const auto store_failed = [&] { return call_ok(r.c(), "machine.status")["store"]["ok"] == false; };
+    const Json job = wait_job(r.c(), id, [&](const Json& j) { return j["state"] != "cutting" || store_failed(); }, 60);
+    if (job["state"] == "cutting" && !store_failed())
+      rec.violations.push_back("the job still says cutting 60 s after the fault");
   }
   const auto before = r.status()["executed_blocks"].get<std::size_t>();
   std::this_thread::sleep_for(std::chrono::seconds(1));

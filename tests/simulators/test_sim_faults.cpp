@@ -164,6 +164,61 @@ TEST(SimFaults, SilentHeartbeatTurnsTheJetOffAndLatchesAnAlarm) {
   EXPECT_EQ(plc.input_register(6), 2) << "alarm_code heartbeat";
 }
 
+// `plc down`: the PLC off the network. Its connections drop, a new one is never answered, and
+// its watchdog runs on: the host's silence trips it. `plc up` serves again, the alarm latched.
+TEST(SimFaults, PlcDownAnswersNothingAndItsWatchdogRunsOn) {
+  FaultSim s({"--modbus", "127.0.0.1:0", "--pressure-ramp", "0.1", "--heartbeat-timeout", "300"});
+  PlcClient plc(s.sim.modbus_port());
+  ASSERT_EQ(modbus_write_bit(plc.ctx, 0, 1), 1);  // pump_enable
+  ASSERT_EQ(modbus_write_bit(plc.ctx, 2, 1), 1);  // jet_on
+  for (uint16_t beat = 1; beat <= 10; ++beat) {
+    ASSERT_EQ(modbus_write_register(plc.ctx, 1, beat), 1);
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  ASSERT_EQ(plc.input_bit(3), 1) << "jet_is_on";
+  EXPECT_EQ(control(s.sim.control_port(), "plc down"), "ok");
+  EXPECT_EQ(plc.input_bit(3), -1) << "the old connection is gone";
+  PlcClient late(s.sim.modbus_port());  // the kernel takes the connection; the PLC never answers
+  modbus_set_response_timeout(late.ctx, 0, 300'000);
+  EXPECT_EQ(late.input_bit(3), -1);
+  std::this_thread::sleep_for(std::chrono::milliseconds(400));  // past the watchdog
+  EXPECT_EQ(control(s.sim.control_port(), "plc up"), "ok");
+  PlcClient back(s.sim.modbus_port());
+  EXPECT_EQ(back.input_bit(3), 0) << "the watchdog closed the jet while nobody could reach the PLC";
+  EXPECT_EQ(back.input_bit(4), 1) << "alarm_latched";
+  EXPECT_EQ(back.input_register(6), 2) << "alarm_code heartbeat";
+  EXPECT_EQ(s.events("plc_down").size(), 1u);
+  EXPECT_EQ(s.events("plc_up").size(), 1u);
+}
+
+// `time-scale K` at run time: the simulated clock goes on from where it was, at the new rate,
+// and the PLC's watchdog keeps its wall-clock timeout and the heartbeat its wall-clock age. It
+// used to keep the age in simulated seconds: slowing from 20× to 1× made a heartbeat 200 ms
+// old look 4 s old, and the watchdog tripped at once.
+TEST(SimFaults, ATimeScaleChangeKeepsTheClockAndTheWatchdogInWallTime) {
+  FaultSim s({"--modbus", "127.0.0.1:0", "--pressure-ramp", "0.1", "--heartbeat-timeout", "1000", "--time-scale", "20"});
+  PlcClient plc(s.sim.modbus_port());
+  ASSERT_EQ(modbus_write_bit(plc.ctx, 0, 1), 1);
+  ASSERT_EQ(modbus_write_bit(plc.ctx, 2, 1), 1);
+  ASSERT_EQ(modbus_write_register(plc.ctx, 1, 1), 1);
+  ASSERT_TRUE(wait_status(s.sim.control_port(), [&](const nlohmann::json&) { return plc.input_bit(3) == 1; }, 5));
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));  // the heartbeat is 200 ms (wall) old
+  const double before = control_status(s.sim.control_port())["t"];
+  EXPECT_EQ(control(s.sim.control_port(), "time-scale 1"), "ok");
+  EXPECT_EQ(plc.input_bit(4), 0) << "a 200 ms old heartbeat is within a 1000 ms watchdog at any scale";
+  EXPECT_EQ(plc.input_bit(3), 1);
+  ASSERT_EQ(modbus_write_register(plc.ctx, 1, 2), 1);
+  const nlohmann::json after = control_status(s.sim.control_port());
+  EXPECT_EQ(after["time_scale"], 1.0);
+  EXPECT_GE(after["t"].get<double>(), before) << "the clock does not go back";
+  EXPECT_LT(after["t"].get<double>(), before + 5) << "nor jump ahead";
+  const auto changes = s.events("time_scale");
+  ASSERT_EQ(changes.size(), 1u);
+  EXPECT_EQ(changes[0]["from"], 20.0);
+  EXPECT_EQ(changes[0]["to"], 1.0);
+  EXPECT_NE(control(s.sim.control_port(), "time-scale 0").find("error"), std::string::npos);
+}
+
 TEST(SimFaults, StallStopsTakingLinesForItsDuration) {
   FaultSim s({"--stall-at", "0.3", "--stall-for", "600"});
   StreamClient c = s.connect();
