@@ -180,7 +180,7 @@ constexpr std::array kLinkKeys{"protocol"sv, "port"sv, "tcp"sv, "baud"sv, "rx_bu
 constexpr std::array kCellKeys{"enabled"sv, "modbus"sv, "modbus_unit"sv, "modbus_timeout_s"sv,
                                "modbus_reconnects"sv, "heartbeat_period_s"sv, "pump_ready_timeout_s"sv,
                                "pressure_setpoint_mpa"sv, "abrasive_g_per_min"sv, "hold_limit_s"sv,
-                               "jet_restart_s"sv};
+                               "jet_restart_s"sv, "idle_poll_s"sv};
 constexpr std::array kPlannerKeys{"lamina"sv,    "workers"sv,          "machine"sv,     "materials"sv,
                                   "timeout_s"sv, "memory_limit_mb"sv, "cpu_limit_s"sv, "nice"sv};
 constexpr std::array kJobsKeys{"roots"sv, "max_model_bytes"sv, "max_stock_file_bytes"sv, "upload_idle_s"sv,
@@ -266,6 +266,7 @@ void read_cell(Section s, CellConfig& c) {
   s.number("modbus_timeout_s", c.modbus_timeout_s, {0.01, 10});
   s.integer("modbus_reconnects", c.modbus_reconnects, 0, 100);
   s.number("heartbeat_period_s", c.heartbeat_period_s, {0.01, 10});
+  s.number("idle_poll_s", c.idle_poll_s, {0, 60});  // 0: the PLC is read between cuts only on request
   s.number("pump_ready_timeout_s", c.pump_ready_timeout_s, {0, 600, true});
   // The PLC takes the set point in 0.1 MPa in a 16-bit register; real pumps stop well below.
   s.number("pressure_setpoint_mpa", c.pressure_setpoint_mpa, {0, 1000, true});

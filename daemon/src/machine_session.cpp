@@ -72,6 +72,7 @@ MachineSession::MachineSession(const DaemonConfig& config)
     drivers::CellIoSettings cs;
     cs.plc = plc_endpoint(config.cell);
     cs.heartbeat_period_s = config.cell.heartbeat_period_s;
+    cs.idle_poll_period_s = config.cell.idle_poll_s;
     cs.pump_ready_timeout_s = config.cell.pump_ready_timeout_s;
     cs.pressure_setpoint_01mpa = static_cast<std::uint16_t>(config.cell.pressure_setpoint_mpa * 10 + 0.5);
     cs.abrasive_g_per_min = static_cast<std::uint16_t>(config.cell.abrasive_g_per_min + 0.5);

@@ -66,6 +66,7 @@ struct CellIo::Impl {
   bool monitoring = false;  // between a successful prepare_cut and finish_cut: heartbeat + polling
   std::uint16_t heartbeat_value = 0;
   Clock::time_point next_heartbeat, next_poll;
+  Clock::time_point next_idle_poll = Clock::now();
 
   Result submit(Kind kind) {
     std::future<Result> done;
@@ -105,7 +106,10 @@ struct CellIo::Impl {
       }
       if (monitoring && Clock::now() >= next_heartbeat) beat();
       if (monitoring && Clock::now() >= next_poll) poll();
-      const auto deadline = monitoring ? std::min(next_heartbeat, next_poll) : Clock::now() + std::chrono::seconds(1);
+      if (!monitoring && settings.idle_poll_period_s > 0 && Clock::now() >= next_idle_poll) idle_poll();
+      const auto deadline = monitoring ? std::min(next_heartbeat, next_poll)
+                                       : settings.idle_poll_period_s > 0 ? next_idle_poll
+                                                                         : Clock::now() + std::chrono::seconds(1);
       std::unique_lock lock(mutex);
       wake.wait_until(lock, deadline,
                       [this] {
@@ -355,6 +359,17 @@ struct CellIo::Impl {
       report(std::move(*f));
     }
   }
+
+  // Between cuts: the inputs for status() only. Nothing is switched and no fault is raised (no
+  // cut to stop); an unreachable PLC is logged once, and read as unknown by status() readers.
+  void idle_poll() {
+    const bool ok = read_inputs().has_value();
+    next_idle_poll = Clock::now() + seconds(settings.idle_poll_period_s * (ok ? 1 : 5));
+    if (!ok && idle_reachable) log->warn("the PLC does not answer between cuts; retrying every {} s", settings.idle_poll_period_s * 5);
+    if (ok && !idle_reachable) log->info("the PLC answers again");
+    idle_reachable = ok;
+  }
+  bool idle_reachable = true;
 
   void link_lost(const LinkError& error) {
     monitoring = false;

@@ -33,6 +33,11 @@ double seconds_between(Clock::time_point a, Clock::time_point b) {
 // behind it reaches the controller within it (plus one chunk).
 constexpr double kPacingBacklogS = 0.015;
 constexpr double kTickS = 0.005;
+// While a feed hold decelerates, the status is asked 50 times a second instead of status_period_s:
+// the hold watch turns the jet off once the report says the machine stands (Hold:0), and at 5 Hz
+// that report came up to 200 ms late — the jet stood on the part that long (fault campaign).
+constexpr double kHoldStatusPeriodS = 0.02;
+constexpr double kHoldWatchAfterRequestS = 2.0;  // a hold asked for: fast reports this long at least
 constexpr double kBannerWaitS = 0.5;
 
 }  // namespace
@@ -60,6 +65,7 @@ struct Streamer::Impl {
   LineSpan pending_span;
   LinkCallbacks callbacks;
   Clock::time_point started{}, last_heard{}, handshake_started{}, last_status_poll{}, flow_running_since{};
+  Clock::time_point fast_status_until{};  // a hold is decelerating: status at kHoldStatusPeriodS
   double pace_credit_bytes = 0;
   Clock::time_point pace_last{};
   std::size_t span_size = 0, first_index = 0;
@@ -248,6 +254,8 @@ struct Streamer::Impl {
           std::lock_guard lock(mutex);
           ++shared_progress.statuses_received;
         }
+        if (s->status.state == ControllerState::hold_pending)
+          fast_status_until = std::max(fast_status_until, Clock::now() + std::chrono::milliseconds(500));
         if (checking_state && streaming) on_state_checked(s->status);
         check_lost_acknowledgement(s->status);
         if (callbacks.on_status) callbacks.on_status(s->status);
@@ -438,7 +446,9 @@ struct Streamer::Impl {
                                                            settings.handshake_timeout_s)});
       return;
     }
-    if (settings.status_period_s > 0 && seconds_between(last_status_poll, now) >= settings.status_period_s) {
+    const double status_period_s =
+        now < fast_status_until ? std::min(settings.status_period_s, kHoldStatusPeriodS) : settings.status_period_s;
+    if (settings.status_period_s > 0 && seconds_between(last_status_poll, now) >= status_period_s) {
       last_status_poll = now;
       send_realtime_bytes(protocol->realtime(RealtimeCommand::status));
     }
@@ -492,6 +502,9 @@ void Streamer::request(RealtimeCommand command) {
   asio::post(impl_->io, [impl = impl_.get(), command, requested] {
     std::string bytes = impl->protocol->realtime(command);
     if (bytes.empty()) return;
+    if (command == RealtimeCommand::feed_hold)
+      impl->fast_status_until = std::max(impl->fast_status_until, requested + std::chrono::duration_cast<Clock::duration>(
+                                                                                  std::chrono::duration<double>(kHoldWatchAfterRequestS)));
     impl->realtime_queue.emplace_back(std::move(bytes), requested);
     impl->pump();
   });

@@ -4,6 +4,9 @@
 
 #include <fmt/format.h>
 
+#include <functional>
+#include <thread>
+
 #include "machine_session.hpp"
 #include "sim_process.hpp"
 
@@ -36,6 +39,31 @@ TEST(MachineSessionStatus, AnUnreachablePlcReadsAsUnknownNotAsItsLastValues) {
                           "alarm_latched", "alarm_code"})
     EXPECT_TRUE(cell[key].is_null()) << key << " still shows a value the PLC can no longer confirm: " << cell.dump();
   EXPECT_TRUE(cell["read_age_s"].is_number()) << "how old the last reading is";
+}
+
+// Between cuts the PLC used to be read only on request: machine.status showed e-stop and door
+// as the last cut left them, with their age. Now it is read every [cell] idle_poll_s.
+TEST(MachineSessionStatus, BetweenCutsThePlcIsReadOnItsOwn) {
+  TempDir dir;
+  SimProcess sim({"--link", dir.file("cnc"), "--modbus", "127.0.0.1:0", "--control", "127.0.0.1:0"});
+  DaemonConfig config;
+  config.link.port = dir.file("cnc");
+  config.cell.modbus = fmt::format("127.0.0.1:{}", sim.modbus_port());
+  config.cell.idle_poll_s = 0.1;
+  MachineSession session(config);
+  const auto wait_cell = [&](const std::function<bool(const nlohmann::json&)>& ready) {
+    for (int i = 0; i < 500; ++i) {
+      if (ready(session.status()["cell"])) return true;
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    return false;
+  };
+  EXPECT_TRUE(wait_cell([](const nlohmann::json& c) { return c["estop_ok"] == true; }))
+      << "read without a cut or a request: " << session.status()["cell"].dump();
+  sim::testing::control(sim.control_port(), "estop on");
+  EXPECT_TRUE(wait_cell([](const nlohmann::json& c) { return c["estop_ok"] == false; }))
+      << "the e-stop pressed between cuts shows: " << session.status()["cell"].dump();
+  EXPECT_LT(session.status()["cell"]["read_age_s"].get<double>(), 2.0);
 }
 
 }  // namespace

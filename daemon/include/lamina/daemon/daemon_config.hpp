@@ -41,6 +41,7 @@ struct CellConfig {
   double modbus_timeout_s = 0.5;           // per request
   int modbus_reconnects = 3;               // per failed request, then the PLC is lost (the cut stops)
   double heartbeat_period_s = 0.2;
+  double idle_poll_s = 1.0;     // between cuts the PLC's inputs are read this often (machine.status)
   double pump_ready_timeout_s = 10;
   double pressure_setpoint_mpa = 380;
   double abrasive_g_per_min = 350;

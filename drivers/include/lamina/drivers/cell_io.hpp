@@ -22,6 +22,9 @@ struct CellIoSettings {
   ModbusEndpoint plc;
   double heartbeat_period_s = 0.2;       // the PLC's watchdog must be longer
   double poll_period_s = 0.05;           // interlocks and pressure read this often while cutting
+  // Between cuts the inputs are read this often (0: never), so e-stop, door and pressure show
+  // as they are, not as the last cut left them; after a failed read, five times as far apart.
+  double idle_poll_period_s = 1.0;
   std::uint16_t pressure_setpoint_01mpa = 3800;
   std::uint16_t abrasive_g_per_min = 350;
   double pump_ready_timeout_s = 10;      // pump on → pump_ready
@@ -54,7 +57,8 @@ struct CellStatus {
   std::optional<std::uint64_t> cnc_executed_blocks;
   ControllerState cnc_state = ControllerState::unknown;  // the CNC's state lamps as the PLC wires them
   // When the values above were last read from the PLC (nullopt: never). They are refreshed
-  // while a cut is monitored, by refresh(), and by the commands; otherwise they age.
+  // while a cut is monitored, by refresh() and the commands, and between cuts every
+  // idle_poll_period_s.
   std::optional<std::chrono::steady_clock::time_point> read_at;
 };
 
@@ -85,8 +89,9 @@ class CellIo {
   // The resume of such a hold, blocking: abrasive feed on, jet consent on, and the PLC read
   // back — an error when the cell cannot cut any more (e-stop, door, pressure).
   std::expected<void, LinkError> restore_jet();
-  // Blocking: read the PLC's inputs now (status() is otherwise refreshed only while a cut is
-  // prepared and monitored) — e.g. the CNC's executed-block count after a restart.
+  // Blocking: read the PLC's inputs now (status() is otherwise refreshed every poll_period_s
+  // while a cut is monitored, every idle_poll_period_s between cuts) — e.g. the CNC's
+  // executed-block count after a restart.
   std::expected<void, LinkError> refresh();
   // The PLC's reset button (coil cnc_reset): flushes a controller that has no reset on its line.
   // Blocking: returns once the PLC reads the CNC idle again, or an error naming the state it
