@@ -57,6 +57,7 @@ struct CellIo::Impl {
   std::atomic<bool> jet_pause_requested{false};
   std::atomic<bool> feed_hold_requested{false};
   std::atomic<bool> cycle_start_requested{false};
+  Clock::time_point feed_hold_requested_at{}, cycle_start_requested_at{};  // under mutex
   std::atomic<bool> stopping{false};
   std::optional<CellFaultReport> fault;
   std::function<void(const CellFaultReport&)> callback;
@@ -83,14 +84,9 @@ struct CellIo::Impl {
     while (true) {
       if (jet_off_requested.exchange(false)) write_jet_off("jet_off() requested");
       if (jet_pause_requested.exchange(false)) pause_jet();
-      if (feed_hold_requested.exchange(false)) {
-        if (auto r = client.write_bit(pm::kCoilCncFeedHold, true); !r)
-          log->warn("feed hold through the PLC: {}", r.error().message);
-      }
-      if (cycle_start_requested.exchange(false)) {
-        if (auto r = client.write_bit(pm::kCoilCncCycleStart, true); !r)
-          log->warn("cycle start through the PLC: {}", r.error().message);
-      }
+      if (feed_hold_requested.exchange(false)) press_if_fresh(pm::kCoilCncFeedHold, "feed hold", feed_hold_requested_at);
+      if (cycle_start_requested.exchange(false))
+        press_if_fresh(pm::kCoilCncCycleStart, "cycle start", cycle_start_requested_at);
       if (stopping) break;
       std::optional<Command> command;
       {
@@ -128,6 +124,35 @@ struct CellIo::Impl {
 
   // Sets a flag the thread acts on. The mutex is taken so the thread cannot miss the wake-up
   // between checking its flags and starting to wait (it would then sleep a whole period).
+  // A button press is a real-time request: pressed late, it lands on a machine that has moved on.
+  // The fault campaign caught one: a feed hold asked while the PLC was off the network reached
+  // the CNC seconds later, after the resume had reset it, and held the new program. A cycle
+  // start that late would start a machine nobody is watching. So a press older than this is
+  // dropped (logged); jet off, in the safe direction, is never dropped.
+  static constexpr double kPressMaxAgeS = 0.5;
+  void press_if_fresh(int coil, const char* button, const Clock::time_point& requested_at) {
+    Clock::time_point at;
+    {
+      std::lock_guard lock(mutex);
+      at = requested_at;
+    }
+    const double age_s = std::chrono::duration<double>(Clock::now() - at).count();
+    if (age_s > kPressMaxAgeS) {
+      log->warn("{} through the PLC dropped: asked {:.1f} s ago, the PLC was busy or unreachable", button, age_s);
+      return;
+    }
+    const auto give_up_at = at + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(kPressMaxAgeS));
+    if (auto r = client.write_bit_before(coil, true, give_up_at); !r)
+      log->warn("{} through the PLC: {}", button, r.error().message);
+  }
+  void signal_press(std::atomic<bool>& flag, Clock::time_point& requested_at) {
+    {
+      std::lock_guard lock(mutex);
+      requested_at = Clock::now();
+    }
+    signal(flag);
+  }
+
   void signal(std::atomic<bool>& flag) {
     {
       std::lock_guard lock(mutex);
@@ -411,8 +436,8 @@ std::expected<void, LinkError> CellIo::finish_cut() { return impl_->submit(Impl:
 void CellIo::jet_off() { impl_->signal(impl_->jet_off_requested); }
 std::expected<void, LinkError> CellIo::reset_cnc() { return impl_->submit(Impl::Kind::reset_cnc); }
 std::expected<void, LinkError> CellIo::hold_cnc() { return impl_->submit(Impl::Kind::hold_cnc); }
-void CellIo::feed_hold() { impl_->signal(impl_->feed_hold_requested); }
-void CellIo::cycle_start() { impl_->signal(impl_->cycle_start_requested); }
+void CellIo::feed_hold() { impl_->signal_press(impl_->feed_hold_requested, impl_->feed_hold_requested_at); }
+void CellIo::cycle_start() { impl_->signal_press(impl_->cycle_start_requested, impl_->cycle_start_requested_at); }
 void CellIo::pause_jet() { impl_->signal(impl_->jet_pause_requested); }
 std::expected<void, LinkError> CellIo::restore_jet() { return impl_->submit(Impl::Kind::restore_jet); }
 std::expected<void, LinkError> CellIo::refresh() { return impl_->submit(Impl::Kind::refresh); }

@@ -79,11 +79,16 @@ bool ModbusClient::connect_once(std::string& error) {
   return true;
 }
 
-std::expected<void, LinkError> ModbusClient::call(const std::string& what, const std::function<int(_modbus*)>& op) {
+std::expected<void, LinkError> ModbusClient::call(const std::string& what, const std::function<int(_modbus*)>& op,
+                                                  std::optional<std::chrono::steady_clock::time_point> give_up_at) {
   std::string last_error;
   for (int attempt = 0; attempt <= target_.max_reconnects; ++attempt) {
     if (attempt > 0) {
       if (abort_ && abort_()) break;
+      if (give_up_at && std::chrono::steady_clock::now() >= *give_up_at) {
+        return std::unexpected(LinkError{LinkErrorCode::timeout,
+                                         fmt::format("PLC {}: {} given up: too late to be of use ({})", where(), what, last_error)});
+      }
       ++reconnects_;
       log_->warn("PLC {}: {} failed ({}); reconnect {}/{}", where(), what, last_error, attempt,
                  target_.max_reconnects);
@@ -135,6 +140,12 @@ std::expected<std::vector<std::uint16_t>, LinkError> ModbusClient::read_register
 std::expected<void, LinkError> ModbusClient::write_bit(int address, bool on) {
   return call(fmt::format("writing coil {} = {}", address, on ? 1 : 0),
               [&](modbus_t* c) { return modbus_write_bit(c, address, on ? 1 : 0); });
+}
+
+std::expected<void, LinkError> ModbusClient::write_bit_before(int address, bool on,
+                                                              std::chrono::steady_clock::time_point give_up_at) {
+  return call(fmt::format("writing coil {} = {}", address, on ? 1 : 0),
+              [&](modbus_t* c) { return modbus_write_bit(c, address, on ? 1 : 0); }, give_up_at);
 }
 
 std::expected<void, LinkError> ModbusClient::write_bits(int address, std::span<const std::uint8_t> bits) {

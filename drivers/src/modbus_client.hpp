@@ -9,7 +9,9 @@
 // the request) is returned at once: reconnecting would not change the answer.
 #include <cstdint>
 #include <expected>
+#include <chrono>
 #include <functional>
+#include <optional>
 #include <memory>
 #include <span>
 #include <string>
@@ -41,6 +43,9 @@ class ModbusClient {
   std::expected<std::vector<std::uint16_t>, LinkError> read_input_registers(int address, int count);
   std::expected<std::vector<std::uint16_t>, LinkError> read_registers(int address, int count);
   std::expected<void, LinkError> write_bit(int address, bool on);
+  // The same, but no reconnect is started after `give_up_at`: for a request that is worth
+  // nothing late (a button press), an error instead of a late success.
+  std::expected<void, LinkError> write_bit_before(int address, bool on, std::chrono::steady_clock::time_point give_up_at);
   std::expected<void, LinkError> write_bits(int address, std::span<const std::uint8_t> bits);
   std::expected<void, LinkError> write_register(int address, std::uint16_t value);
   std::expected<void, LinkError> write_registers(int address, std::span<const std::uint16_t> values);
@@ -54,7 +59,8 @@ class ModbusClient {
 
  private:
   // Runs op on a connected context; the retry policy above. `what` names the request in errors.
-  std::expected<void, LinkError> call(const std::string& what, const std::function<int(_modbus*)>& op);
+  std::expected<void, LinkError> call(const std::string& what, const std::function<int(_modbus*)>& op,
+                                      std::optional<std::chrono::steady_clock::time_point> give_up_at = {});
   bool connect_once(std::string& error);
 
   ModbusEndpoint target_;

@@ -178,6 +178,7 @@ struct ModbusServer::Impl {
         cut_off();
         continue;
       }
+      if (!network_applied) close_unread_backlog();  // sent while it was down: lost with the link
       network_applied = true;
       fd_set readable;
       FD_ZERO(&readable);
@@ -212,17 +213,22 @@ struct ModbusServer::Impl {
   }
 
   // The PLC off the network (a cable pulled, a switch down): its logic runs on, the heartbeat
-  // watchdog included, but no request is answered. Connections it had are gone; new ones wait
-  // unaccepted in the backlog, so a host sees timeouts, as behind a dead link.
+  // watchdog included, but no request reaches it. Connections it had are gone; a new one waits
+  // unaccepted (the host sees timeouts, as behind a dead link) and is closed unread when the
+  // network is back: what a host sent into the dead link is lost, never served late.
   void cut_off() {
     for (auto& c : clients) drop(c);
     clients.clear();
+    network_applied = false;
     fd_set readable;
     FD_ZERO(&readable);
     FD_SET(wake[0], &readable);
-    network_applied = false;
     timeval timeout{0, 50'000};
     if (::select(wake[0] + 1, &readable, nullptr, nullptr, &timeout) > 0 && FD_ISSET(wake[0], &readable)) drain_wake();
+  }
+
+  void close_unread_backlog() {  // the listening socket is non-blocking
+    for (int fd; (fd = ::accept(listen_fd, nullptr, nullptr)) >= 0;) ::close(fd);
   }
 
   void drain_wake() {

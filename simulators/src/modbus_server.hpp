@@ -25,7 +25,8 @@ class ModbusServer {
 
   int port() const;
   std::size_t requests_served() const;
-  // Off the network: every client dropped, nothing answered or accepted until it is back.
+  // Off the network: every client dropped, new connections left unanswered and closed unread
+  // when it is back.
   void set_network_up(bool up);
   bool network_up() const;
 

@@ -13,7 +13,7 @@
 // reactions meet as at a real machine, and speeds up again once the operator has resumed.
 //
 //   fault-campaign [--runs N] [--seed S] [--faults a,b,…] [--time-scale K] [--fault-time-scale K]
-//                  [--jet-limit-ms MS] [--restart-limit-ms MS] [--out FILE]
+//                  [--jet-limit-ms MS] [--restart-limit-ms MS] [--out FILE] [--only-run N]
 #include <sqlite3.h>
 
 #include <random>
@@ -38,6 +38,7 @@ struct Options {
   double jet_limit_ms = 100;
   double restart_limit_ms = 1100;  // [cell] jet_restart_s (1 s) and the jet limit
   std::string out;
+  std::size_t only_run = 0;  // 1-based: repeat that one run of the seed (to look into a violation)
 };
 
 // One run's cell: the simulator, a small disk for the state folder when the fault needs one,
@@ -278,7 +279,8 @@ Options parse_options(int argc, char** argv) {
     else if (a == "--jet-limit-ms") o.jet_limit_ms = std::stod(value());
     else if (a == "--restart-limit-ms") o.restart_limit_ms = std::stod(value());
     else if (a == "--out") o.out = value();
-    else throw std::runtime_error("unknown option " + a + " (--runs --seed --faults --time-scale --fault-time-scale --jet-limit-ms --restart-limit-ms --out)");
+    else if (a == "--only-run") o.only_run = std::stoul(value());
+    else throw std::runtime_error("unknown option " + a + " (--runs --seed --faults --time-scale --fault-time-scale --jet-limit-ms --restart-limit-ms --out --only-run)");
   }
   for (const auto& name : o.faults)
     if (std::none_of(faults().begin(), faults().end(), [&](const Fault& f) { return f.name == name; }))
@@ -295,6 +297,7 @@ int run_campaign(const Options& opt) {
   std::map<std::string, std::array<std::size_t, 3>> tally;  // runs, violating runs, skipped
   std::map<std::string, double> worst_jet_ms;
   for (std::size_t i = 0; i < opt.runs; ++i) {
+    if (opt.only_run && i + 1 != opt.only_run) continue;
     const Fault& fault = *chosen[i % chosen.size()];  // round robin: each fault as often
     RunRecord rec;
     try {

@@ -212,6 +212,28 @@ TEST(CellIo, PlcLostWhileCuttingIsLinkLostWithoutHanging) {
   EXPECT_LT(seconds_since(t0), 3.0);
 }
 
+// Found by the fault campaign: with the PLC off the network, the cut's feed hold waited in
+// CellIo behind the reconnects, and reached the CNC when the PLC came back — after the resume
+// had reset the CNC, so the new program started held. A late cycle start would start a
+// machine by itself. Presses that cannot be made within 0.5 s are dropped now.
+TEST(CellIo, AButtonPressTheUnreachablePlcCouldNotTakeIsNotMadeLate) {
+  SimCell cell;
+  CellIo io(settings_for(cell.sim.modbus_port()));
+  ASSERT_TRUE(io.prepare_cut());
+  ASSERT_EQ(sim::testing::control(cell.sim.control_port(), "plc down"), "ok");
+  io.feed_hold();  // the Modbus thread is in its reconnects now
+  io.cycle_start();
+  std::this_thread::sleep_for(std::chrono::milliseconds(900));
+  ASSERT_EQ(sim::testing::control(cell.sim.control_port(), "plc up"), "ok");
+  ASSERT_TRUE(eventually([&] { return io.refresh().has_value(); }, 10.0)) << "the PLC answers again";
+  bool up = false;
+  for (const auto& r : sim::testing::read_log(cell.log())) {
+    if (r.value("event", "") == "plc_up") up = true;
+    EXPECT_FALSE(up && r.value("event", "") == "plc_button") << "a press made late: " << r.dump();
+  }
+  EXPECT_TRUE(up);
+}
+
 TEST(CellIo, FinishCutLeavesPumpAbrasiveAndJetOff) {
   SimCell cell;
   PlcProbe plc(cell.sim.modbus_port());

@@ -82,6 +82,8 @@ class CellIo {
   // controllers whose line has no real-time hold (a drip-fed Fanuc). Right after jet_off().
   void feed_hold();
   // The PLC's cycle-start button (coil cnc_cycle_start): continues a held drip feed.
+  // Both presses are dropped (logged) if the Modbus thread cannot make them within 0.5 s (the
+  // PLC busy reconnecting): a late press lands on a machine that has moved on.
   void cycle_start();
   // A feed hold that stands still: jet and abrasive feed off now, from any thread (as
   // jet_off(), the abrasive after it); the pump stays pressurised for the resume.
