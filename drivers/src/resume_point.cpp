@@ -73,6 +73,22 @@ bool has_axis_word(const std::string& words) {
   return words.find_first_of("XYZAC") != std::string::npos;
 }
 
+// Whether contour lines [first_unfinished, end) hold no cut: the jet M-code (from the contour's
+// start on) is off for every move left, so all that remains is its jet-off and retract.
+bool cut_finished(const std::vector<std::string>& program, std::size_t contour_start, std::size_t first_unfinished,
+                  std::size_t end) {
+  bool jet = false;
+  for (std::size_t i = contour_start; i < end; ++i) {
+    const std::string words = words_of(program[i]);
+    if (const auto m = word_value(words, 'M')) {
+      if (*m == 3 || *m == 4) jet = true;
+      if (*m == 5) jet = false;
+    }
+    if (i >= first_unfinished && jet && has_axis_word(words) && !has_g(words, 4)) return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 bool takes_planner_block(std::string_view line) {
@@ -115,6 +131,21 @@ std::expected<ResumePlan, LinkError> plan_resume(const std::vector<std::string>&
     return std::unexpected(LinkError{LinkErrorCode::bad_request,
                                      "the program carries no (CONTOUR …) markers: no safe point to resume from"});
   if (plan.contour < 0) return plan;  // nothing of a contour ran yet: start over from the top
+  // A contour whose cutting moves have all run is finished even if its jet-off and retract have
+  // not: restarting it would cut it twice (the fault campaign: a pressure drop on contour 27's
+  // last line). The resume goes on at the next contour, or after the cut if it was the last.
+  std::size_t next_marker = program.size();
+  for (std::size_t i = plan.restart_index + 1; i < program.size() && next_marker == program.size(); ++i)
+    if (contour_marker(program[i])) next_marker = i;
+  if (first_unfinished > plan.restart_index &&
+      cut_finished(program, plan.restart_index, first_unfinished, next_marker)) {
+    if (next_marker < program.size()) {
+      plan.restart_index = next_marker;
+      plan.contour = *contour_marker(program[next_marker]);
+    } else {
+      plan.restart_index = first_unfinished;
+    }
+  }
   // The set-up the program makes before its first contour, minus motion: units, distance and
   // feed modes. Then inverse time off (the contour may have ended in G93) and a retract.
   for (std::size_t i = 0; i < first_marker; ++i) {

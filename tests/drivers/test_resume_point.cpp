@@ -63,7 +63,17 @@ TEST(ResumePoint, RestartsAtTheContourMarkerWithSetUpAndRetract) {
   EXPECT_EQ(plan->preamble, preamble) << "modal set-up, inverse time off, retract to the contour's rapid height";
   // Stopped on the marker itself: contour 0 had finished, restart at contour 1.
   EXPECT_EQ(plan_resume(kProgram, 12)->restart_index, 12u);
-  EXPECT_EQ(plan_resume(kProgram, 11)->restart_index, 3u);
+  // Stopped in contour 0 after its last cut, before its jet-off (10) or its retract (11): the
+  // contour is finished. It used to restart at contour 0 and cut it twice (the fault campaign).
+  EXPECT_EQ(plan_resume(kProgram, 11)->restart_index, 12u);
+  EXPECT_EQ(plan_resume(kProgram, 10)->restart_index, 12u);
+  EXPECT_EQ(plan_resume(kProgram, 10)->contour, 1);
+  // Its last cut not finished: the contour again.
+  EXPECT_EQ(plan_resume(kProgram, 9)->restart_index, 3u);
+  EXPECT_EQ(plan_resume(kProgram, 7)->restart_index, 3u) << "the pierce";
+  // The last contour's cut done: go on after it (jet off, program end), not into it again.
+  EXPECT_EQ(plan_resume(kProgram, 19)->restart_index, 19u);
+  EXPECT_EQ(plan_resume(kProgram, 18)->restart_index, 12u);
 }
 
 TEST(ResumePoint, BeforeTheFirstContourStartsOverAndWithoutMarkersRefuses) {
