@@ -397,6 +397,29 @@ nlohmann::json SimRuntime::status_json() const {
           {"jet_commanded", machine_.jet_commanded()}};
 }
 
+// The campaign's controls (docs/reliability.md): the clock's rate and the PLC's network.
+// Throws std::invalid_argument on a bad number, as handle_command's other commands do.
+std::optional<std::string> SimRuntime::clock_or_network_command(const std::string& verb, const std::string& arg,
+                                                                double now) {
+  if (verb == "time-scale") {
+    const double k = std::stod(arg);
+    if (!(k > 0 && k <= 1000)) return "error: time-scale K needs a factor in (0, 1000]";
+    const double from = clock_.scale();
+    log_.write_event("time_scale", now, {{"from", from}, {"to", k}});
+    std::lock_guard lock(plc_mutex_);
+    clock_.set_scale(k);
+    plc_.rescale_watchdog(now, k / from);
+    return "ok";
+  }
+  if (verb == "plc" && (arg == "down" || arg == "up")) {
+    if (!modbus_) return "error: plc down|up needs the PLC (--modbus)";
+    modbus_->set_network_up(arg == "up");
+    log_.write_event(arg == "up" ? "plc_up" : "plc_down", now, {{"source", "control"}});
+    return "ok";
+  }
+  return std::nullopt;
+}
+
 std::string SimRuntime::handle_command(const std::string& line) {
   std::istringstream in(line);
   std::string verb, arg;
@@ -419,22 +442,7 @@ std::string SimRuntime::handle_command(const std::string& line) {
     if (verb == "pressure" && (arg == "drop" || arg == "restore"))
       return plc_fault([&] { plc_.set_pressure_drop(arg == "drop"); },
                        arg == "drop" ? "pressure_drop" : "pressure_restore");
-    if (verb == "time-scale") {
-      const double k = std::stod(arg);
-      if (!(k > 0 && k <= 1000)) return "error: time-scale K needs a factor in (0, 1000]";
-      const double from = clock_.scale();
-      log_.write_event("time_scale", now, {{"from", from}, {"to", k}});
-      std::lock_guard lock(plc_mutex_);
-      clock_.set_scale(k);
-      plc_.rescale_watchdog(now, k / from);
-      return "ok";
-    }
-    if (verb == "plc" && (arg == "down" || arg == "up")) {
-      if (!modbus_) return "error: plc down|up needs the PLC (--modbus)";
-      modbus_->set_network_up(arg == "up");
-      log_.write_event(arg == "up" ? "plc_up" : "plc_down", now, {{"source", "control"}});
-      return "ok";
-    }
+    if (auto reply = clock_or_network_command(verb, arg, now)) return *reply;
     if (verb == "stall") {
       const double ms = std::stod(arg);
       if (!(ms > 0)) return "error: stall MS needs a positive number of milliseconds";

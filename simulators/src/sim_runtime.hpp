@@ -51,6 +51,7 @@ class SimRuntime {
   void apply_schedule(double wall, double now);
   void unplug(double now, const std::string& why);
   std::string handle_command(const std::string& line);
+  std::optional<std::string> clock_or_network_command(const std::string& verb, const std::string& arg, double now);
   nlohmann::json status_json() const;
 
   SimOptions options_;
