@@ -122,8 +122,6 @@ struct CellIo::Impl {
     commands.clear();
   }
 
-  // Sets a flag the thread acts on. The mutex is taken so the thread cannot miss the wake-up
-  // between checking its flags and starting to wait (it would then sleep a whole period).
   // A button press is a real-time request: pressed late, it lands on a machine that has moved on.
   // The fault campaign caught one: a feed hold asked while the PLC was off the network reached
   // the CNC seconds later, after the resume had reset it, and held the new program. A cycle
@@ -153,6 +151,8 @@ struct CellIo::Impl {
     signal(flag);
   }
 
+  // Sets a flag the thread acts on. The mutex is taken so the thread cannot miss the wake-up
+  // between checking its flags and starting to wait (it would then sleep a whole period).
   void signal(std::atomic<bool>& flag) {
     {
       std::lock_guard lock(mutex);
