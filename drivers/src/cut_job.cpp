@@ -1,10 +1,13 @@
 #include "lamina/drivers/cut_job.hpp"
 
 #include <chrono>
+#include <memory>
 #include <thread>
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
+
+#include "latest_relay.hpp"
 
 namespace lamina::drivers {
 namespace {
@@ -199,6 +202,15 @@ CutReport CutJob::stream_span(std::size_t from, std::vector<std::string> preambl
     accepted_at_status_ = from;
     queued_at_status_.reset();
   }
+  // Progress records leave the link's thread (latest_relay.hpp). The relay is closed, its last
+  // callback done, before this returns: the owner records the outcome after, never before it.
+  const auto relay = progress_ ? std::make_shared<detail::LatestRelay<CutReport>>(progress_) : nullptr;
+  struct CloseRelay {
+    std::shared_ptr<detail::LatestRelay<CutReport>> relay;
+    ~CloseRelay() {
+      if (relay) relay->close();
+    }
+  } close_relay{relay};
   LinkCallbacks callbacks;
   callbacks.on_status = [this](const ControllerStatus& status) {
     const LinkProgress p = link_.progress();
@@ -213,13 +225,13 @@ CutReport CutJob::stream_span(std::size_t from, std::vector<std::string> preambl
       queued_at_status_ = static_cast<std::size_t>(std::max(0, *capacity - *status.planner_blocks_free));
     }
   };
-  callbacks.on_progress = [this](const LinkProgress& p) {
+  callbacks.on_progress = [this, relay](const LinkProgress& p) {
     {
       std::lock_guard lock(mutex_);
       report_.lines_accepted = span_first_ + p.lines_accepted;
       report_.bytes_sent = p.bytes_sent;
     }
-    if (progress_) progress_(report());
+    if (relay) relay->post(report());
   };
   std::vector<std::string> lines(program_.begin() + static_cast<std::ptrdiff_t>(from), program_.end());
   link_.start(LineSpan{std::move(lines), from}, callbacks);

@@ -9,7 +9,7 @@
 #include "lamina/drivers/cut_job.hpp"
 #include "lamina/drivers/streamer.hpp"
 #include "link_test_support.hpp"
-#include "pty_link.hpp"
+#include "sim_cut.hpp"
 #include "modbus_test_client.hpp"
 
 namespace lamina::drivers::testing {
@@ -20,64 +20,6 @@ constexpr int kInAbrasiveFlow = 1;      // g/min (docs/modbus-map.md)
 constexpr int kCoilCncFeedHold = 4;     // the PLC's panel buttons
 constexpr int kCoilCncCycleStart = 5;
 
-struct HeldCut {
-  explicit HeldCut(CutJobSettings settings, bool with_plc = true)
-      : sim([&] {
-          std::vector<std::string> args{"--link", dir.file("cnc"), "--log", dir.file("exec.jsonl"), "--control",
-                                        "127.0.0.1:0", "--time-scale", "1"};
-          if (with_plc) args.insert(args.end(), {"--modbus", "127.0.0.1:0", "--pressure-ramp", "0.2"});
-          return args;
-        }()),
-        program(contour_program(3, 150)),
-        link(grbl_pty_link(dir.file("cnc"))) {
-    if (with_plc) {
-      CellIoSettings cs;
-      cs.plc.port = sim.modbus_port();
-      cell = std::make_unique<CellIo>(cs);
-    }
-    job = std::make_unique<CutJob>(*link, cell.get(), program, settings);
-  }
-  ~HeldCut() {
-    if (cutter.joinable()) cutter.join();
-  }
-  void start() {
-    cutter = std::thread([this] { report = job->run(); });
-  }
-  CutReport finish() {
-    cutter.join();
-    return report;
-  }
-  bool cutting_with_the_jet_on() {
-    return sim::testing::wait_status(sim.control_port(), [](const nlohmann::json& st) {
-      return st["jet_commanded"] == true && st["executed_blocks"].get<int>() > 40 && st["state"] == "run";
-    }, 30);
-  }
-  std::vector<nlohmann::json> events(const std::string& kind) const {
-    std::vector<nlohmann::json> out;
-    for (const auto& r : sim::testing::read_log(dir.file("exec.jsonl")))
-      if (r.value("event", "") == kind) out.push_back(r);
-    return out;
-  }
-
-  TempDir dir;
-  SimProcess sim;
-  std::vector<std::string> program;
-  std::unique_ptr<Streamer> link;
-  std::unique_ptr<CellIo> cell;
-  std::unique_ptr<CutJob> job;
-  std::thread cutter;
-  CutReport report;
-};
-
-bool wait_for(const std::function<bool()>& ready, double wait_s) {
-  const auto t0 = std::chrono::steady_clock::now();
-  while (std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() < wait_s) {
-    if (ready()) return true;
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  }
-  return false;
-}
-
 void press(int modbus_port, int coil) {
   modbus_t* ctx = modbus_new_tcp("127.0.0.1", modbus_port);
   ASSERT_EQ(modbus_connect(ctx), 0);
@@ -87,7 +29,7 @@ void press(int modbus_port, int coil) {
 }
 
 TEST(FeedHold, TheJetGoesOffOnceTheMachineStandsAndResumeOpensItBeforeTheMotion) {
-  HeldCut cut({.jet_restart_s = 0.5});
+  SimCut cut({.jet_restart_s = 0.5});
   cut.start();
   ASSERT_TRUE(cut.cutting_with_the_jet_on());
   cut.job->hold();
@@ -127,7 +69,7 @@ TEST(FeedHold, TheJetGoesOffOnceTheMachineStandsAndResumeOpensItBeforeTheMotion)
 }
 
 TEST(FeedHold, LongerThanTheLimitBecomesAStopAndTheResumeRunsEveryContourOnce) {
-  HeldCut cut({.hold_limit_s = 1.0, .jet_restart_s = 0.2});
+  SimCut cut({.hold_limit_s = 1.0, .jet_restart_s = 0.2});
   cut.start();
   ASSERT_TRUE(cut.cutting_with_the_jet_on());
   cut.job->hold();
@@ -150,7 +92,7 @@ TEST(FeedHold, LongerThanTheLimitBecomesAStopAndTheResumeRunsEveryContourOnce) {
 // machine's own cycle start then would move it with the jet off: the job stops instead, and
 // only Lamina's resume (which opens the jet first) goes on.
 TEST(FeedHold, ThePanelsHoldTurnsTheJetOffAndItsCycleStartStopsTheJob) {
-  HeldCut cut({.jet_restart_s = 0.2});
+  SimCut cut({.jet_restart_s = 0.2});
   cut.start();
   ASSERT_TRUE(cut.cutting_with_the_jet_on());
   press(cut.sim.modbus_port(), kCoilCncFeedHold);
@@ -168,7 +110,7 @@ TEST(FeedHold, ThePanelsHoldTurnsTheJetOffAndItsCycleStartStopsTheJob) {
 // Without a PLC nothing turns the jet off and keeps the position: a standing hold is a stop,
 // whose soft reset turns the controller's jet M-code off.
 TEST(FeedHold, WithoutAPlcAStandingHoldIsAStopWithTheJetOff) {
-  HeldCut cut({}, false);
+  SimCut cut({}, {.with_plc = false});
   cut.start();
   ASSERT_TRUE(cut.cutting_with_the_jet_on());
   cut.job->hold();
