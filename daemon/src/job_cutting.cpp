@@ -92,6 +92,7 @@ std::expected<void, RpcError> JobManager::start_cut(JobRecord& job, CutStart how
   cutting_ = true;
   pause_ = PauseKind::none;
   cut_->on_progress([this, id = job.id, index = sheet->index](const drivers::CutReport& r) { save_progress(id, index, r); });
+  cut_->on_hold([this, id = job.id](const drivers::LinkError& why) { machine_held(id, why); });
   cutter_ = std::thread([this, id = job.id, index = sheet->index, how, program = std::move(program)]() mutable {
     cut_sheet(id, index, how, std::move(program), std::nullopt);
   });
@@ -163,6 +164,18 @@ std::size_t JobManager::interrupted_resume_line(const SheetRecord& sheet, const 
     note = "no executed-block count (no PLC): from the last acknowledged line's contour; check the part";
   }
   return sheet.last_acked_line > 0 ? sheet.last_acked_line - 1 : 0;
+}
+
+// A hold the operator did not ask for through us — the machine ran dry with the jet on and the
+// job held it, or the PLC's or the controller's own hold button — with the jet off: the job is
+// paused as by machine.hold, so job.resume / machine.resume opens the jet and continues.
+void JobManager::machine_held(const std::string& job_id, const drivers::LinkError& why) {
+  std::lock_guard lock(mutex_);
+  JobRecord* job = find(job_id);
+  if (!job || job->state != JobState::cutting || !cutting_) return;
+  log()->warn("job {}: held: {}", job_id, why.message);
+  pause_ = PauseKind::hold;
+  (void)set_state(*job, JobState::paused, why.message);
 }
 
 void JobManager::save_progress(const std::string& job_id, int sheet_index, const drivers::CutReport& r) {

@@ -94,6 +94,7 @@ class JobManager {
                  std::optional<std::size_t> resume_line);
   void finish_cut(const std::string& job_id, int sheet, const drivers::CutReport& report);
   void save_progress(const std::string& job_id, int sheet, const drivers::CutReport& report);
+  void machine_held(const std::string& job_id, const drivers::LinkError& why);
   std::size_t interrupted_resume_line(const SheetRecord& sheet, const std::vector<std::string>& program,
                                       std::string& note);
 

@@ -14,6 +14,7 @@ void decode_cell_inputs(std::span<const std::uint8_t> inputs, std::span<const st
   status.pump_ready = inputs[pm::kInputPumpReady] != 0;
   status.jet_is_on = inputs[pm::kInputJetIsOn] != 0;
   status.alarm_latched = inputs[pm::kInputAlarmLatched] != 0;
+  status.cnc_jet_request = inputs[pm::kInputCncJetRequest] != 0;
   status.pressure_mpa = mpa_from_01mpa(registers[pm::kInPressure]);
   status.abrasive_g_per_min = registers[pm::kInAbrasiveFlow];
   status.alarm_code = registers[pm::kInAlarmCode];

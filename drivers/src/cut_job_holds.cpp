@@ -6,12 +6,14 @@
 #include <spdlog/spdlog.h>
 
 #include "hold_guard.hpp"
+#include "latest_relay.hpp"
 #include "lamina/drivers/cut_job.hpp"
+#include "starvation_watch.hpp"
 
 namespace lamina::drivers {
 namespace {
 using Clock = std::chrono::steady_clock;
-constexpr auto kWatchPeriod = std::chrono::milliseconds(20);
+constexpr auto kWatchPeriod = std::chrono::milliseconds(10);
 }  // namespace
 
 void CutJob::hold() {
@@ -66,9 +68,44 @@ ControllerState CutJob::observed_state() const {
   return ControllerState::unknown;
 }
 
+void CutJob::on_hold(std::function<void(const LinkError&)> callback) { on_hold_ = std::move(callback); }
+
+// What the PLC shows of the machine for the starvation rule; nullopt while there is nothing to
+// judge (no PLC, no count, the resume's preamble, the span not loaded yet).
+std::optional<detail::StarvationReading> CutJob::starvation_reading(Clock::time_point t0) const {
+  if (!cell_) return std::nullopt;  // no PLC, no water: the valve's consent is the PLC's
+  const CellStatus c = cell_->status();
+  if (!c.read_at || !c.cnc_executed_blocks) return std::nullopt;
+  std::size_t from = 0, preamble = 0;
+  std::optional<std::uint64_t> base;
+  {
+    std::lock_guard lock(mutex_);
+    from = report_.attempt_first_line;
+    preamble = report_.attempt_preamble_lines;
+    base = report_.executed_base;
+  }
+  const LinkProgress p = link_.progress();
+  if (!base || p.lines_total != program_.size() - from) return std::nullopt;
+  detail::StarvationReading r;
+  r.cnc_state = c.cnc_state;
+  r.water_flowing = c.jet_is_on && c.cnc_jet_request;
+  if (*c.cnc_executed_blocks >= *base + preamble)
+    r.standing_at = from + static_cast<std::size_t>(*c.cnc_executed_blocks - *base - preamble);
+  r.lines_sent_end = from + p.lines_sent;
+  r.read_at_s = std::chrono::duration<double>(*c.read_at - t0).count();
+  return r;
+}
+
 void CutJob::watch_holds() {
   detail::HoldGuard guard({.hold_limit_s = settings_.hold_limit_s, .jet_restart_s = settings_.jet_restart_s});
+  detail::StarvationWatch starvation(program_);
   const auto t0 = Clock::now();
+  // The owner records the hold (a synced write): never on this thread, which must go on watching.
+  std::optional<detail::LatestRelay<LinkError>> announcements;
+  if (on_hold_) announcements.emplace(on_hold_);
+  const auto announce = [&](const LinkError& why) {
+    if (announcements) announcements->post(why);
+  };
   const auto stop_job = [&](LinkError why) {
     spdlog::warn("cut: {}", why.message);
     {
@@ -85,7 +122,8 @@ void CutJob::watch_holds() {
           return stop_job({LinkErrorCode::held_too_long,
                            "the machine stands in a feed hold and there is no PLC to turn the jet off: stopped"});
         spdlog::info("cut: the machine stands in a feed hold: jet and abrasive off");
-        return cell_->pause_jet();
+        cell_->pause_jet();
+        return announce({LinkErrorCode::controller_held, "the machine stands in a feed hold: jet and abrasive off"});
       case detail::HoldAction::jet_on:
         if (!cell_) return;
         spdlog::info("cut: resuming the hold: jet and abrasive on, motion in {:.1f} s", settings_.jet_restart_s);
@@ -96,7 +134,26 @@ void CutJob::watch_holds() {
         if (cell_) cell_->cycle_start();
         return;
       case detail::HoldAction::stop: return stop_job(*guard.stop_reason());
+      case detail::HoldAction::starved_hold: return;  // carried out below, with its reason
     }
+  };
+  // The starvation was seen by the PLC; the link's last report may be older than it and still
+  // say Run. Its state counts again from the second report after the hold was asked for.
+  std::optional<std::size_t> stale_reports_until;
+  const auto check_starvation = [&](double now_s) {
+    const auto reading = starvation_reading(t0);
+    const auto why = reading ? starvation.on_reading(*reading) : std::nullopt;
+    if (!why || guard.on_starved(now_s) != detail::HoldAction::starved_hold) return;
+    spdlog::warn("cut: {}", why->message);
+    stale_reports_until = link_.progress().statuses_received + 1;
+    hold();  // the motion first: lines on their way must not run dry
+    if (cell_) cell_->pause_jet();
+    announce(*why);
+  };
+  const auto fresh_state = [&]() -> std::optional<ControllerState> {
+    if (stale_reports_until && link_.progress().statuses_received <= *stale_reports_until) return std::nullopt;
+    stale_reports_until.reset();
+    return observed_state();
   };
   std::unique_lock lock(hold_mutex_);
   while (hold_watching_) {
@@ -108,7 +165,8 @@ void CutJob::watch_holds() {
     // Before our first line a held controller is the streamer's to report (controller_held).
     if (!stopping_ && link_.progress().lines_sent > 0) {
       if (resume) act(guard.on_resume_request(now_s));
-      act(guard.on_state(observed_state(), now_s));
+      if (const auto state = fresh_state()) act(guard.on_state(*state, now_s));
+      check_starvation(now_s);
     } else if (resume && !stopping_) {
       link_.request(RealtimeCommand::resume);  // nothing of ours is in the controller yet
     }

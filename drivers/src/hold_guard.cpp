@@ -18,17 +18,20 @@ HoldAction HoldGuard::stop(LinkError why) {
 
 HoldAction HoldGuard::on_state(ControllerState state, double now_s) {
   if (stop_reason_) return HoldAction::none;
-  if (moving(state)) {
+  if (moving(state) || (starved_ && state == ControllerState::hold_pending)) {
     if (jet_off_ && !cycle_started_)
       return stop({LinkErrorCode::left_hold_without_jet,
-                   "the machine left the feed hold by itself (its own cycle start?) while the jet was off: "
-                   "stopped; resume through Lamina, which opens the jet first"});
+                   starved_ ? "the machine moved on after it ran dry, before the hold took, with the jet off: "
+                              "stopped; resume from the contour's start"
+                            : "the machine left the feed hold by itself (its own cycle start?) while the jet was off: "
+                              "stopped; resume through Lamina, which opens the jet first"});
     held_since_s_.reset();  // the hold is over (or there was none)
-    jet_off_ = cycle_started_ = false;
+    jet_off_ = cycle_started_ = starved_ = false;
     restart_at_s_.reset();
     return HoldAction::none;
   }
-  if (state != ControllerState::hold) return HoldAction::none;  // decelerating, idle, alarm, door: not ours
+  const bool standing = state == ControllerState::hold || (starved_ && state == ControllerState::idle);
+  if (!standing) return HoldAction::none;  // decelerating, idle, alarm, door: not ours
   if (!held_since_s_) held_since_s_ = now_s;
   if (restart_at_s_) {
     if (now_s < *restart_at_s_) return HoldAction::none;
@@ -47,6 +50,13 @@ HoldAction HoldGuard::on_state(ControllerState state, double now_s) {
                              "contour's start",
                              settings_.hold_limit_s)});
   return HoldAction::none;
+}
+
+HoldAction HoldGuard::on_starved(double now_s) {
+  if (stop_reason_ || jet_off_ || restart_at_s_ || cycle_started_) return HoldAction::none;
+  starved_ = jet_off_ = true;
+  held_since_s_ = now_s;
+  return HoldAction::starved_hold;
 }
 
 HoldAction HoldGuard::on_resume_request(double now_s) {

@@ -30,6 +30,7 @@ enum class HoldAction {
   jet_on,          // the operator resumes: jet and abrasive on (then wait jet_restart_s)
   cycle_start,     // the jet has had its restart time: continue the motion
   stop,            // stop the job with stop_reason()
+  starved_hold,    // the machine ran dry with the jet on: feed hold, then jet and abrasive off
 };
 
 class HoldGuard {
@@ -42,6 +43,12 @@ class HoldGuard {
   // by the hold (then on_state() says cycle_start after the restart time), cycle_start when it
   // was never off (a hold still decelerating, or no jet to restore).
   HoldAction on_resume_request(double now_s);
+  // The machine stands Idle mid-program with the water on (starvation_watch.hpp): starved_hold,
+  // once, unless a hold already has the jet off. It is then held as after any hold: the
+  // operator's resume opens the jet and continues. An Idle machine counts as standing in it
+  // (a controller may not enter Hold from Idle), and one that moves before the resume, even
+  // decelerating into the hold (lines that reached it first), moved with the jet off: a stop.
+  HoldAction on_starved(double now_s);
 
   bool jet_off_by_hold() const { return jet_off_; }
   const std::optional<LinkError>& stop_reason() const { return stop_reason_; }
@@ -54,6 +61,7 @@ class HoldGuard {
   bool jet_off_ = false;                   // we turned the jet off for this hold
   std::optional<double> restart_at_s_;     // resuming: the jet is on, the motion waits until then
   bool cycle_started_ = false;             // resuming: cycle start sent, waiting to leave the hold
+  bool starved_ = false;                   // this hold is a starvation's
   std::optional<LinkError> stop_reason_;
 };
 

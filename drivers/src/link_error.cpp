@@ -19,6 +19,7 @@ const char* to_string(LinkErrorCode code) {
     case LinkErrorCode::controller_held: return "controller_held";
     case LinkErrorCode::held_too_long: return "held_too_long";
     case LinkErrorCode::left_hold_without_jet: return "left_hold_without_jet";
+    case LinkErrorCode::starved: return "starved";
   }
   return "unknown";
 }

@@ -21,6 +21,7 @@ inline constexpr int kInputDoorClosed = 1;
 inline constexpr int kInputPumpReady = 2;
 inline constexpr int kInputJetIsOn = 3;
 inline constexpr int kInputAlarmLatched = 4;
+inline constexpr int kInputCncJetRequest = 5;  // the CNC's own jet output (its M-code), wired in
 inline constexpr int kInputCount = 6;
 
 // Input registers (read together: 0…19).

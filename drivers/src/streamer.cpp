@@ -344,6 +344,8 @@ struct Streamer::Impl {
                              {
                                std::lock_guard lock(mutex);
                                shared_progress.bytes_sent += n;
+                               // Out now, not at the next answer: a controller that stalls answers nothing.
+                               shared_progress.lines_sent = protocol->lines_sent();
                              }
                              // A drip feed is done when its last byte is out: no ack will come.
                              if (streaming && loaded && protocol->finished()) {

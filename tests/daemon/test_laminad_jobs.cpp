@@ -12,6 +12,16 @@ namespace {
 const std::string kModel = std::string(LAMINA_EXAMPLES_DIR) + "/knob.stl";
 const std::string kRemnants = std::string(LAMINA_EXAMPLES_DIR) + "/remnants.toml";
 
+bool wait_for_log_event(const Cell& cell, const std::string& kind, double wait_s) {
+  const auto t0 = std::chrono::steady_clock::now();
+  while (seconds_since(t0) < wait_s) {
+    for (const auto& r : sim::testing::read_log(cell.log()))
+      if (r.value("event", "") == kind) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  return false;
+}
+
 // Confirms sheets as they come until the job completes (or stops being runnable).
 Json run_to_completion(RpcClient& c, const std::string& id, double wait_s) {
   const auto t0 = std::chrono::steady_clock::now();
@@ -125,6 +135,61 @@ TEST(LaminadJobs, HoldThenResumeFinishesTheSheet) {
   const auto log = executed(cell.log());
   ASSERT_EQ(log.size(), lines.size());
   for (std::size_t i = 0; i < log.size(); ++i) ASSERT_EQ(log[i].line, lines[i]);
+}
+
+// The first contour after line `after` with at least `cuts` cutting moves (modal: lines of
+// coordinates after the G1): its comment's index.
+std::size_t long_contour(const std::vector<std::string>& lines, std::size_t after, int cuts) {
+  std::size_t start = 0;
+  int moves = 0;
+  for (std::size_t i = after; i < lines.size(); ++i) {
+    if (lines[i].find("(CONTOUR") == 0) {
+      if (start && moves >= cuts) return start;
+      start = i;
+      moves = 0;
+    } else if (lines[i][0] == 'X' || lines[i][0] == 'Y' || lines[i].find("G1") != std::string::npos) {
+      ++moves;
+    }
+  }
+  return 0;
+}
+
+// The CNC stops taking lines mid-contour (its serial input hangs 3 s: lamina-sim `stall`) and
+// runs dry with the water on. The daemon holds it with the jet off and pauses the job with the
+// reason; the operator's resume goes on, and every line runs once. A small queue (16 planner
+// blocks, 256 bytes) at real time, so it runs dry well inside the contour.
+TEST(LaminadJobs, AMachineThatRunsDryPausesTheJobWithTheJetOffForTheOperator) {
+  Cell cell({"--planner-blocks", "16", "--rx-buffer", "256"}, 10);
+  Laminad daemon(cell.config(), cell.dir.file(""));
+  RpcClient c = connect(cell.socket());
+  const std::string id = cut_sheet_one_of_the_knob(c, cell, daemon, 10);
+  ASSERT_FALSE(id.empty());
+  const auto lines = program_lines(call_ok(c, "job.get", {{"job", id}})["sheets"][0]["program"]);
+  const std::size_t contour = long_contour(lines, 300, 60);
+  ASSERT_GT(contour, 0u) << "no contour of 60 cuts in the knob's first sheet";
+  const int port = cell.sim.control_port();
+  const auto executed_past = [&](std::size_t n) {
+    return sim::testing::wait_status(port, [n](const Json& s) { return s["executed_blocks"].get<std::size_t>() > n; }, 60);
+  };
+  ASSERT_TRUE(executed_past(contour - 40));
+  EXPECT_EQ(sim::testing::control(port, "time-scale 1").substr(0, 2), "ok");
+  ASSERT_TRUE(executed_past(contour + 10));
+  EXPECT_EQ(sim::testing::control(port, "stall 3000").substr(0, 2), "ok");
+  const Json paused = wait_job(c, id, [](const Json& j) { return j["state"] != "cutting"; }, 30);
+  ASSERT_EQ(paused["state"], "paused") << paused.dump(2) << daemon.log();
+  EXPECT_NE(paused["error"].get<std::string>().find("ran out of program"), std::string::npos) << paused["error"];
+  lamina::drivers::testing::PlcProbe plc(cell.sim.modbus_port());
+  EXPECT_EQ(plc.input(lamina::drivers::testing::map::kInputJetIsOn), 0) << "the jet is off while it stands";
+  ASSERT_TRUE(wait_for_log_event(cell, "stall_end", 10));
+  EXPECT_EQ(sim::testing::control_status(cell.sim.control_port())["state"], "hold") << "it never resumes by itself";
+  call_ok(c, "job.resume", {{"job", id}});
+  EXPECT_EQ(sim::testing::control(port, "time-scale 40").substr(0, 2), "ok");
+  const Json job = run_to_completion(c, id, 300);
+  ASSERT_EQ(job["state"], "completed") << job.dump(2);
+  const auto log = executed(cell.log());
+  for (std::size_t i = 0; i < std::min(log.size(), lines.size()); ++i)
+    ASSERT_EQ(log[i].line, lines[i]) << "line " << i + 1 << "\n" << daemon.log();
+  ASSERT_EQ(log.size(), lines.size());
 }
 
 TEST(LaminadJobs, AbortStopsSafelyAndJobResumeRestartsAtTheContour) {

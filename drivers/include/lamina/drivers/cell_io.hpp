@@ -21,7 +21,7 @@ namespace lamina::drivers {
 struct CellIoSettings {
   ModbusEndpoint plc;
   double heartbeat_period_s = 0.2;       // the PLC's watchdog must be longer
-  double poll_period_s = 0.05;           // interlocks and pressure read this often while cutting
+  double poll_period_s = 0.025;          // interlocks, pressure and the CNC read this often while cutting
   // Between cuts the inputs are read this often (0: never), so e-stop, door and pressure show
   // as they are, not as the last cut left them; after a failed read, five times as far apart.
   double idle_poll_period_s = 1.0;
@@ -48,6 +48,9 @@ struct CellFaultReport {
 struct CellStatus {
   bool connected = false;
   bool estop_ok = false, door_closed = false, pump_ready = false, jet_is_on = false, alarm_latched = false;
+  // The CNC's own jet output (its jet-on M-code) as wired into the PLC. The water flows when
+  // both this and jet_is_on (the valve's consent) are set.
+  bool cnc_jet_request = false;
   double pressure_mpa = 0;
   double abrasive_g_per_min = 0;
   int alarm_code = 0;

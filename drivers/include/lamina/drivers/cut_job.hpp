@@ -5,6 +5,7 @@
 // operator. It never resumes by itself: resume() is the operator's call, and restarts at the
 // start of the contour that was being cut (resume_point.hpp).
 #include <atomic>
+#include <chrono>
 #include <condition_variable>
 #include <cstddef>
 #include <cstdint>
@@ -20,6 +21,9 @@
 #include "lamina/drivers/resume_point.hpp"
 
 namespace lamina::drivers {
+namespace detail {
+struct StarvationReading;
+}
 
 struct CutJobSettings {
   double stop_timeout_s = 5;        // feed hold → the machine reports Hold / Idle / Alarm
@@ -83,7 +87,13 @@ class CutJob {
   void abort(std::string why);
 
   CutReport report() const;
+  // Called (on a thread of the job's own; set before run) with each progress record.
   void on_progress(std::function<void(const CutReport&)> callback);
+  // Called (on the hold watch's thread; set before run) when the machine is found standing in
+  // a hold the job did not ask for, with the jet turned off: the PLC's or the controller's own
+  // hold button (controller_held), or the machine ran dry mid-program (starved, and the job
+  // held it). The job waits for continue_motion() as after hold().
+  void on_hold(std::function<void(const LinkError&)> callback);
 
  private:
   CutReport stream_from(std::size_t from, std::vector<std::string> preamble);  // with the hold watch
@@ -102,6 +112,7 @@ class CutJob {
   void stop_hold_watch();
   void watch_holds();
   ControllerState observed_state() const;
+  std::optional<detail::StarvationReading> starvation_reading(std::chrono::steady_clock::time_point t0) const;
   std::optional<LinkError> hold_stop() const;
 
   MachineLink& link_;
@@ -111,6 +122,7 @@ class CutJob {
   mutable std::mutex mutex_;
   CutReport report_;
   std::function<void(const CutReport&)> progress_;
+  std::function<void(const LinkError&)> on_hold_;
   std::atomic<bool> stopping_{false};
   std::optional<LinkError> stop_reason_;
   std::size_t span_first_ = 0;

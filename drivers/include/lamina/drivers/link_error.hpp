@@ -21,6 +21,7 @@ enum class LinkErrorCode : int {
   controller_held = 13,   // in feed hold or with its door open before our first line: it would run nothing
   held_too_long = 14,     // a feed hold outlasted [cut] hold_limit_s: it became a stop
   left_hold_without_jet = 15,  // the machine left a hold by itself while the hold had the jet off
+  starved = 16,           // a hold's reason: the controller ran out of program with the jet on
 };
 
 struct LinkError {

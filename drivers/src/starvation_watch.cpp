@@ -1,0 +1,35 @@
+#include "starvation_watch.hpp"
+
+#include <fmt/format.h>
+
+namespace lamina::drivers::detail {
+
+StarvationWatch::StarvationWatch(const std::vector<std::string>& program) {
+  waits_.reserve(program.size());
+  for (const auto& line : program) waits_.push_back(grbl_line_wait(line));
+}
+
+std::optional<LinkError> StarvationWatch::on_reading(const StarvationReading& r) {
+  const bool dry = r.water_flowing && r.cnc_state == ControllerState::idle && r.standing_at &&
+                   *r.standing_at < waits_.size() && !waits_[*r.standing_at].syncs;
+  if (!dry) {
+    seen_at_.reset();
+    return std::nullopt;
+  }
+  const std::size_t line = *r.standing_at;
+  if (seen_at_ != line) {
+    seen_at_ = line;
+    seen_since_s_ = r.read_at_s;
+  }
+  const bool unsent = line >= r.lines_sent_end;
+  if (!unsent && r.read_at_s - seen_since_s_ < kConfirmS) return std::nullopt;
+  return LinkError{
+      LinkErrorCode::starved,
+      fmt::format("the controller ran out of program before line {} and stood Idle with the jet on ({}): held, "
+                  "jet and abrasive off; resume when the cause is gone",
+                  line + 1,
+                  unsent ? "the host had not sent that line yet: the host or the line too slow"
+                         : "it had the line and did not run it: its serial input stalled")};
+}
+
+}  // namespace lamina::drivers::detail
