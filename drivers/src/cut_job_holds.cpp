@@ -142,13 +142,18 @@ void CutJob::watch_holds() {
   std::optional<std::size_t> stale_reports_until;
   const auto check_starvation = [&](double now_s) {
     const auto reading = starvation_reading(t0);
-    const auto why = reading ? starvation.on_reading(*reading) : std::nullopt;
-    if (!why || guard.on_starved(now_s) != detail::HoldAction::starved_hold) return;
-    spdlog::warn("cut: {}", why->message);
+    const auto dry = reading ? starvation.on_reading(*reading) : std::nullopt;
+    if (!dry || guard.stop_reason() || hold_stop()) return;
+    if (!dry->host_behind) {
+      if (cell_) cell_->jet_off();  // the independent path first: the stop goes through the link
+      return stop_job(dry->why);
+    }
+    if (guard.on_starved(now_s) != detail::HoldAction::starved_hold) return;
+    spdlog::warn("cut: {}", dry->why.message);
     stale_reports_until = link_.progress().statuses_received + 1;
     hold();  // the motion first: lines on their way must not run dry
     if (cell_) cell_->pause_jet();
-    announce(*why);
+    announce(dry->why);
   };
   const auto fresh_state = [&]() -> std::optional<ControllerState> {
     if (stale_reports_until && link_.progress().statuses_received <= *stale_reports_until) return std::nullopt;

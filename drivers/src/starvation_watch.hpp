@@ -31,6 +31,15 @@ struct StarvationReading {
   double read_at_s = 0;                    // when the PLC was read
 };
 
+struct Starvation {
+  // The host had not sent the block: the link is sound, the stream goes on when the cause is
+  // gone — a hold (code starved). Else the controller has the block and does not run it: its
+  // input hung, or a line or an answer was lost — a stop now (code timeout), which the link's
+  // stall rule would make only after its margin with the water on all along.
+  bool host_behind = false;
+  LinkError why;
+};
+
 class StarvationWatch {
  public:
   // Two readings this far apart at the same block confirm a controller that has its next line
@@ -39,8 +48,8 @@ class StarvationWatch {
 
   explicit StarvationWatch(const std::vector<std::string>& program);
 
-  // The reason to hold, once the machine is seen standing dry with the water on; nullopt else.
-  std::optional<LinkError> on_reading(const StarvationReading& reading);
+  // Once the machine is seen standing dry with the water on, what it is; nullopt else.
+  std::optional<Starvation> on_reading(const StarvationReading& reading);
 
  private:
   std::vector<LineWait> waits_;

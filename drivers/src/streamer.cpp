@@ -66,6 +66,10 @@ struct Streamer::Impl {
   LinkCallbacks callbacks;
   Clock::time_point started{}, last_heard{}, handshake_started{}, last_status_poll{}, flow_running_since{};
   Clock::time_point fast_status_until{};  // a hold is decelerating: status at kHoldStatusPeriodS
+  // Lines whose bytes the transport has written (LinkProgress::lines_sent): a line taken into a
+  // write that has not completed (an adapter that hangs) has not reached the controller.
+  std::size_t lines_out = 0;
+  std::size_t span_serial = 0;  // a write of an earlier span completing does not count in this one
   double pace_credit_bytes = 0;
   Clock::time_point pace_last{};
   std::size_t span_size = 0, first_index = 0;
@@ -117,6 +121,8 @@ struct Streamer::Impl {
     }
     span_size = span.lines.size();
     first_index = span.first_index;
+    lines_out = 0;
+    ++span_serial;
     started = last_heard = flow_running_since = Clock::now();
     streaming = true;
     loaded = false;
@@ -331,8 +337,9 @@ struct Streamer::Impl {
     if (streaming && loaded) write_buffer += paced_program_bytes();
     if (write_buffer.empty()) return;
     writing = true;
+    const std::size_t lines_in_write = protocol->lines_sent(), serial = span_serial;
     transport->async_write(std::span(reinterpret_cast<const std::uint8_t*>(write_buffer.data()), write_buffer.size()),
-                           [this](std::error_code ec, std::size_t n) {
+                           [this, lines_in_write, serial](std::error_code ec, std::size_t n) {
                              writing = false;
                              const auto now = Clock::now();
                              for (auto t : realtime_in_write_times) record_latency(seconds_between(t, now));
@@ -345,7 +352,8 @@ struct Streamer::Impl {
                                std::lock_guard lock(mutex);
                                shared_progress.bytes_sent += n;
                                // Out now, not at the next answer: a controller that stalls answers nothing.
-                               shared_progress.lines_sent = protocol->lines_sent();
+                               if (serial == span_serial) lines_out = std::max(lines_out, lines_in_write);
+                               shared_progress.lines_sent = std::max(lines_out, protocol->lines_accepted());
                              }
                              // A drip feed is done when its last byte is out: no ack will come.
                              if (streaming && loaded && protocol->finished()) {
@@ -385,7 +393,7 @@ struct Streamer::Impl {
 
   void publish_progress() {
     std::lock_guard lock(mutex);
-    shared_progress.lines_sent = protocol->lines_sent();
+    shared_progress.lines_sent = std::max(lines_out, protocol->lines_accepted());
     shared_progress.lines_accepted = protocol->lines_accepted();
     shared_progress.seconds = seconds_between(started, Clock::now());
   }

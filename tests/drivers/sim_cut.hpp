@@ -21,6 +21,8 @@ struct SimCutOptions {
   bool with_plc = true;
   std::vector<std::string> program = contour_program(3, 150);
   double baud = 115200;  // the simulator's line and the host's pacing alike
+  // The link to the simulator's PTY at `path` (default: grbl_pty_link at `baud`).
+  std::function<std::unique_ptr<Streamer>(const std::string& path)> make_link;
 };
 
 struct SimCut {
@@ -32,7 +34,7 @@ struct SimCut {
           return args;
         }()),
         program(std::move(options.program)),
-        link(grbl_pty_link(dir.file("cnc"), options.baud)) {
+        link(options.make_link ? options.make_link(dir.file("cnc")) : grbl_pty_link(dir.file("cnc"), options.baud)) {
     if (options.with_plc) {
       CellIoSettings cs;
       cs.plc.port = sim.modbus_port();

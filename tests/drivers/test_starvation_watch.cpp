@@ -17,20 +17,23 @@ StarvationReading reading(S state, std::size_t at, std::size_t sent_end, double 
 
 TEST(StarvationWatch, IdleWithTheWaterOnAtALineNotSentIsStarvationAtOnce) {
   StarvationWatch w(kProgram);
-  const auto why = w.on_reading(reading(S::idle, 5, 5, 1.0));
-  ASSERT_TRUE(why);
-  EXPECT_EQ(why->code, LinkErrorCode::starved);
-  EXPECT_NE(why->message.find("line 6"), std::string::npos) << why->message;
-  EXPECT_NE(why->message.find("had not sent"), std::string::npos) << why->message;
+  const auto dry = w.on_reading(reading(S::idle, 5, 5, 1.0));
+  ASSERT_TRUE(dry);
+  EXPECT_TRUE(dry->host_behind) << "a hold: the link is sound";
+  EXPECT_EQ(dry->why.code, LinkErrorCode::starved);
+  EXPECT_NE(dry->why.message.find("line 6"), std::string::npos) << dry->why.message;
+  EXPECT_NE(dry->why.message.find("had not sent"), std::string::npos) << dry->why.message;
 }
 
-TEST(StarvationWatch, ALineTheControllerHasNeedsASecondReadingAtTheSameBlock) {
+TEST(StarvationWatch, ALineTheControllerHasNeedsASecondReadingAndIsAStall) {
   StarvationWatch w(kProgram);
   EXPECT_FALSE(w.on_reading(reading(S::idle, 5, 8, 1.0))) << "between a dwell's end and the next block";
   EXPECT_FALSE(w.on_reading(reading(S::idle, 5, 8, 1.0 + StarvationWatch::kConfirmS / 2)));
-  const auto why = w.on_reading(reading(S::idle, 5, 8, 1.0 + StarvationWatch::kConfirmS));
-  ASSERT_TRUE(why);
-  EXPECT_NE(why->message.find("did not run it"), std::string::npos) << why->message;
+  const auto dry = w.on_reading(reading(S::idle, 5, 8, 1.0 + StarvationWatch::kConfirmS));
+  ASSERT_TRUE(dry);
+  EXPECT_FALSE(dry->host_behind) << "a stop: the controller has the line";
+  EXPECT_EQ(dry->why.code, LinkErrorCode::timeout);
+  EXPECT_NE(dry->why.message.find("stalled"), std::string::npos) << dry->why.message;
   // It moved on between the readings: a new block starts the confirmation again.
   StarvationWatch w2(kProgram);
   EXPECT_FALSE(w2.on_reading(reading(S::idle, 4, 8, 1.0)));
