@@ -101,11 +101,8 @@ void CutJob::watch_holds() {
   detail::StarvationWatch starvation(program_);
   const auto t0 = Clock::now();
   // The owner records the hold (a synced write): never on this thread, which must go on watching.
-  std::optional<detail::LatestRelay<LinkError>> announcements;
-  if (on_hold_) announcements.emplace(on_hold_);
-  const auto announce = [&](const LinkError& why) {
-    if (announcements) announcements->post(why);
-  };
+  detail::LatestRelay<LinkError> announcements([this](const LinkError& why) { if (on_hold_) on_hold_(why); });
+  const auto announce = [&](const LinkError& why) { announcements.post(why); };
   const auto stop_job = [&](LinkError why) {
     spdlog::warn("cut: {}", why.message);
     {
