@@ -174,6 +174,34 @@ CutReport CutJob::stream_from(std::size_t from, std::vector<std::string> preambl
   return r;
 }
 
+// What the link tells this job while a span streams: the report's status and resume data, and
+// the progress records, handed to `relay` (null: nobody listens).
+LinkCallbacks CutJob::span_callbacks(std::shared_ptr<detail::LatestRelay<CutReport>> relay) {
+  LinkCallbacks callbacks;
+  callbacks.on_status = [this](const ControllerStatus& status) {
+    const LinkProgress p = link_.progress();
+    std::lock_guard lock(mutex_);
+    report_.last_status = status;
+    // An alarm flushes the controller's queue: its Bf then says nothing of what ran.
+    if (status.state == ControllerState::alarm || stopping_) return;
+    const auto capacity = settings_.planner_blocks ? std::optional<int>(static_cast<int>(settings_.planner_blocks))
+                                                   : p.planner_blocks;
+    if (capacity && status.planner_blocks_free) {
+      accepted_at_status_ = span_first_ + p.lines_accepted;
+      queued_at_status_ = static_cast<std::size_t>(std::max(0, *capacity - *status.planner_blocks_free));
+    }
+  };
+  callbacks.on_progress = [this, relay](const LinkProgress& p) {
+    {
+      std::lock_guard lock(mutex_);
+      report_.lines_accepted = span_first_ + p.lines_accepted;
+      report_.bytes_sent = p.bytes_sent;
+    }
+    if (relay) relay->post(report());
+  };
+  return callbacks;
+}
+
 CutReport CutJob::stream_span(std::size_t from, std::vector<std::string> preamble) {
   stopping_ = false;
   set_state(CutState::cutting);
@@ -211,28 +239,7 @@ CutReport CutJob::stream_span(std::size_t from, std::vector<std::string> preambl
       if (relay) relay->close();
     }
   } close_relay{relay};
-  LinkCallbacks callbacks;
-  callbacks.on_status = [this](const ControllerStatus& status) {
-    const LinkProgress p = link_.progress();
-    std::lock_guard lock(mutex_);
-    report_.last_status = status;
-    // An alarm flushes the controller's queue: its Bf then says nothing of what ran.
-    if (status.state == ControllerState::alarm || stopping_) return;
-    const auto capacity = settings_.planner_blocks ? std::optional<int>(static_cast<int>(settings_.planner_blocks))
-                                                   : p.planner_blocks;
-    if (capacity && status.planner_blocks_free) {
-      accepted_at_status_ = span_first_ + p.lines_accepted;
-      queued_at_status_ = static_cast<std::size_t>(std::max(0, *capacity - *status.planner_blocks_free));
-    }
-  };
-  callbacks.on_progress = [this, relay](const LinkProgress& p) {
-    {
-      std::lock_guard lock(mutex_);
-      report_.lines_accepted = span_first_ + p.lines_accepted;
-      report_.bytes_sent = p.bytes_sent;
-    }
-    if (relay) relay->post(report());
-  };
+  const LinkCallbacks callbacks = span_callbacks(relay);
   std::vector<std::string> lines(program_.begin() + static_cast<std::ptrdiff_t>(from), program_.end());
   link_.start(LineSpan{std::move(lines), from}, callbacks);
   auto outcome = link_.wait(settings_.finish_timeout_s);

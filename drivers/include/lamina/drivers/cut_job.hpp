@@ -10,6 +10,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <string>
@@ -23,6 +24,8 @@
 namespace lamina::drivers {
 namespace detail {
 struct StarvationReading;
+template <typename T>
+class LatestRelay;
 }
 
 struct CutJobSettings {
@@ -98,6 +101,7 @@ class CutJob {
  private:
   CutReport stream_from(std::size_t from, std::vector<std::string> preamble);  // with the hold watch
   CutReport stream_span(std::size_t from, std::vector<std::string> preamble);
+  LinkCallbacks span_callbacks(std::shared_ptr<detail::LatestRelay<CutReport>> relay);
   std::optional<LinkError> wait_until_run_out();
   bool refuse_unsendable();
   // Blocks the CNC has finished, from the link's status or the PLC's (nullopt: neither says).
