@@ -87,6 +87,32 @@ std::expected<std::vector<double>, Error> fit_to_model(const Mesh& mesh, const L
   return t;
 }
 
+// Where the stack ends against the model's top (issue 17, item 3): taller or shorter, and whether
+// the stock could not end it nearer than half its thinnest sheet or within the tolerance.
+void add_stack_end_warnings(const Layering& out, double z_base, double thinnest, const LayeringParams& params,
+                            std::vector<std::string>& w) {
+  if (out.layers.empty()) return;
+  const LayerSpan& top = out.layers.back();
+  const double off = out.stack_height_mm - out.model_height_mm;
+  if (off > 1e-6)
+    w.push_back(fmt::format("the stack is {:.3f} mm taller than the model ({:.3f} mm vs {:.3f} mm): the top "
+                            "{} mm sheet covers the last {:.3f} mm of the model",
+                            off, out.stack_height_mm, out.model_height_mm, top.thickness_mm,
+                            z_base + out.model_height_mm - top.z_bottom_mm));
+  if (off < -1e-6)
+    w.push_back(fmt::format("the stack is {:.3f} mm shorter than the model ({:.3f} mm vs {:.3f} mm): the model's top "
+                            "{:.3f} mm is not cut",
+                            -off, out.stack_height_mm, out.model_height_mm, -off));
+  if (std::abs(off) > 0.5 * thinnest + 1e-6)
+    w.push_back(fmt::format("the stock cannot end the stack within half its thinnest sheet ({} mm) of the model's "
+                            "top: it ends {:.3f} mm {} it (--side {})",
+                            0.5 * thinnest, std::abs(off), off > 0 ? "above" : "below", cut_side_name(params.fit.side)));
+  else if (std::abs(off) > params.tolerance_mm + 1e-9 && params.method == LayeringMethod::optimal)
+    w.push_back(fmt::format("no stack of this stock ends within the tolerance ({} mm) of the model's top: the nearest "
+                            "ends {:.3f} mm {} it",
+                            params.tolerance_mm, std::abs(off), off > 0 ? "above" : "below"));
+}
+
 }  // namespace
 
 std::expected<Layering, Error> choose_layers(const Mesh& mesh, const LayeringParams& params) {
@@ -110,15 +136,17 @@ std::expected<Layering, Error> choose_layers(const Mesh& mesh, const LayeringPar
     l.thickness_mm = t[static_cast<std::size_t>(c.thickness_index)];
     l.estimated_deviation_mm = c.estimate;
     l.within_tolerance = c.within;
+    l.shortfall = !c.surface_within;
     out.layers.push_back(l);
   }
   out.stack_height_mm = out.layers.empty() ? 0.0 : out.layers.back().z_top_mm() - est.z_base();
 
-  // Shortfalls: runs of layers where no sheet met the tolerance (the thinnest was used).
+  // Shortfalls: runs of layers where no sheet met the tolerance (the thinnest was used); a last
+  // layer out of tolerance only for where it ends is said below, not here.
   for (std::size_t i = 0; i < out.layers.size(); ++i) {
     const LayerSpan& l = out.layers[i];
-    if (l.within_tolerance) continue;
-    if (i > 0 && !out.layers[i - 1].within_tolerance) {
+    if (!l.shortfall) continue;
+    if (i > 0 && out.layers[i - 1].shortfall) {
       Shortfall& s = out.shortfalls.back();
       s.z_to_mm = l.z_top_mm();
       s.deviation_mm = std::max(s.deviation_mm, l.estimated_deviation_mm);
@@ -145,14 +173,7 @@ std::expected<Layering, Error> choose_layers(const Mesh& mesh, const LayeringPar
                               "nearest grid lines",
                               params.bond_mm, params.sub_slice_mm));
   }
-  const double over = out.stack_height_mm - out.model_height_mm;
-  if (over > 1e-6 && !out.layers.empty()) {
-    const LayerSpan& top = out.layers.back();
-    w.push_back(fmt::format("the stack is {:.3f} mm taller than the model ({:.3f} mm vs {:.3f} mm): the top "
-                            "{} mm sheet covers the last {:.3f} mm of the model",
-                            over, out.stack_height_mm, out.model_height_mm, top.thickness_mm,
-                            est.z_base() + out.model_height_mm - top.z_bottom_mm));
-  }
+  add_stack_end_warnings(out, est.z_base(), t.front(), params, w);
   for (const Shortfall& s : out.shortfalls) {
     if (params.method == LayeringMethod::greedy)
       w.push_back(fmt::format("between z {:.3f} and {:.3f} mm no sheet meets the area/triangle criteria: the "

@@ -2,9 +2,11 @@
 // sheet and fall back to thinner ones while the layer fails the area-deviation or the staircase
 // triangle criterion. One refinement a shop would make anyway: near the top, of the sheets
 // that would reach the model's top only the thinnest is tried (a 10 mm sheet is not used for
-// the last 2 mm when a 2.5 mm one reaches too).
+// the last 2 mm when a 2.5 mm one reaches too). Where the stack may end follows the cut side
+// (StackEnd), and the last layer's estimate includes how far it ends from the model's top.
 #include "layering_internal.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace lamina::layering_detail {
@@ -18,20 +20,25 @@ std::vector<ChosenLayer> layer_greedy(Estimator& est, const LayeringParams& para
   const std::size_t max_layers = static_cast<std::size_t>(std::ceil(h / t.front())) + 2;
   while (layers.size() < max_layers) {
     est.release_below(est.span(z, t.front()).ka);
-    int reach = -1;  // the thinnest sheet that reaches the top
-    for (std::size_t i = 0; i < t.size() && reach < 0; ++i)
-      if (z + t[i] >= h - kReachEps) reach = static_cast<int>(i);
+    int reach = -1;  // the thinnest sheet that ends the stack
+    for (std::size_t i = 0; i < t.size() && reach < 0; ++i) {
+      const StackEnd e = est.stack_end(z + t[i]);
+      if (e.allowed && e.final) reach = static_cast<int>(i);
+    }
     int chosen = -1;
     for (int i = static_cast<int>(t.size()) - 1; i >= 0 && chosen < 0; --i) {
-      if (reach >= 0 && i > reach) continue;
+      if ((reach >= 0 && i > reach) || !est.stack_end(z + t[static_cast<std::size_t>(i)]).allowed) continue;
       const auto check = est.greedy_check(est.span(z, t[static_cast<std::size_t>(i)]), i);
       if (check.area_ok && check.triangle_ok) chosen = i;
     }
     const bool ok = chosen >= 0;
     if (!ok) chosen = 0;
     const double th = t[static_cast<std::size_t>(chosen)];
-    layers.push_back(ChosenLayer{z, chosen, est.estimate(est.span(z, th), chosen), ok});
-    if (z + th >= h - kReachEps) break;
+    const StackEnd end = est.stack_end(z + th);
+    // The last layer's estimate includes how far the stack ends from the model's top.
+    const double estimate = std::max(est.estimate(est.span(z, th), chosen), end.final ? end.off_top_mm : 0.0);
+    layers.push_back(ChosenLayer{z, chosen, estimate, ok, ok});
+    if (end.final) break;
     z += th + params.bond_mm;
   }
   return layers;

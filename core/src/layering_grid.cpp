@@ -123,6 +123,28 @@ GridSpan Estimator::span(double z_rel, double thickness) const {
   return g;
 }
 
+StackEnd Estimator::stack_end(double top_rel) const {
+  StackEnd e;
+  const double h = height_;
+  switch (params_.fit.side) {
+    case CutSide::outside:
+      e.final = top_rel >= h - kReachEps;
+      e.off_top_mm = std::max(0.0, top_rel - h);
+      break;
+    case CutSide::inside:
+      e.allowed = top_rel <= h + kReachEps;
+      e.final = e.allowed && top_rel + params_.bond_mm + thicknesses_.front() > h + kReachEps;
+      e.off_top_mm = std::max(0.0, h - top_rel);
+      break;
+    case CutSide::mixed:
+      e.final = top_rel >= h - 0.5 * thicknesses_.front() - kReachEps;
+      e.off_top_mm = std::abs(top_rel - h);
+      break;
+  }
+  if (e.off_top_mm <= kReachEps) e.off_top_mm = 0.0;
+  return e;
+}
+
 double Estimator::search_width(int thickness_index) const {
   return thicknesses_[static_cast<std::size_t>(thickness_index)] * tan_reach_ + 2 * step_;
 }

@@ -61,6 +61,18 @@ struct Sample {
   double slope = 0.0;
 };
 
+// Whether a layer whose top is at a height (above the model's bottom) may end the stack, and how
+// far that top is from the model's (issue 17, item 3). The cut side decides which way it may
+// miss: outside keeps the whole model (a stack ends at or above its top), inside never leaves
+// material beyond it (at or below, ending when no thinnest sheet fits any more), mixed ends
+// within half the thinnest sheet either way. off_top_mm is a deviation of the last layer: the
+// model's top face is that far from the stack's, or the stack's from the model's.
+struct StackEnd {
+  bool allowed = true;  // inside: a top above the model's is not
+  bool final = false;
+  double off_top_mm = 0.0;
+};
+
 class Estimator {
  public:
   // Validated params; thicknesses sorted ascending without duplicates.
@@ -77,6 +89,7 @@ class Estimator {
   // The grid lines a layer [z_rel, z_rel + thickness] is estimated on (never empty: a layer
   // starting within half a step of the top still reads the last step).
   GridSpan span(double z_rel, double thickness) const;
+  StackEnd stack_end(double top_rel) const;
 
   // Achievable-deviation estimates of several layers at once (memoized; parallel inside when
   // params.parallel; the values do not depend on it). With a finite fail_above, a layer whose
@@ -148,8 +161,9 @@ class Estimator {
 struct ChosenLayer {
   double z_rel = 0.0;
   int thickness_index = 0;
-  double estimate = 0.0;
-  bool within = true;
+  double estimate = 0.0;  // of the surface, and for the last layer also how far it ends from the top
+  bool within = true;     // the estimate (optimal) or the criteria (greedy) met
+  bool surface_within = true;  // the same without the distance to the top (false: a shortfall)
 };
 
 std::vector<ChosenLayer> layer_optimal(Estimator& est, const LayeringParams& params);

@@ -1,5 +1,5 @@
 #pragma once
-// Solids of revolution for the bevel tests: a closed profile in the (r, z) half-plane turned
+// Solids of revolution for tests: a closed profile in the (r, z) half-plane turned
 // about the z axis. Profile points on the axis (r = 0) close the solid there without slivers.
 #include "lamina/core/triangle_soup.hpp"
 
@@ -9,7 +9,7 @@
 #include <utility>
 #include <vector>
 
-namespace lamina::bevel_test {
+namespace lamina::test_shapes {
 
 struct RZ {
   double r, z;
@@ -51,4 +51,4 @@ inline TriangleSoup revolve(const std::vector<RZ>& profile, int segments) {
   return soup;
 }
 
-}  // namespace lamina::bevel_test
+}  // namespace lamina::test_shapes

@@ -15,8 +15,8 @@
 namespace lamina {
 namespace {
 
-using bevel_test::RZ;
-using bevel_test::revolve;
+using test_shapes::RZ;
+using test_shapes::revolve;
 using bevel_test::uniform_layers;
 
 Mesh build(const TriangleSoup& soup) {

@@ -35,8 +35,13 @@ struct LayeringParams {
 struct LayerSpan {
   double z_bottom_mm = 0.0;
   double thickness_mm = 0.0;
-  double estimated_deviation_mm = 0.0;  // the layering's own (grid) estimate of the achievable deviation
-  bool within_tolerance = true;         // the estimate met the tolerance (optimal) / criteria (greedy)
+  // The layering's own (grid) estimate of the achievable deviation; for the last layer it includes
+  // how far the stack's top lies from the model's (a sheet 3 mm above the model is 3 mm off).
+  double estimated_deviation_mm = 0.0;
+  bool within_tolerance = true;  // the estimate met the tolerance (optimal) / criteria (greedy)
+  // No sheet met the tolerance (criteria) here and the thinnest was used. A last layer can be out
+  // of tolerance for where it ends alone: then this is false.
+  bool shortfall = false;
   double z_top_mm() const { return z_bottom_mm + thickness_mm; }
 };
 
