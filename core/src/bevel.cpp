@@ -3,6 +3,7 @@
 // normal, the cut lines fitted to that profile, and passes assembled from the lines.
 #include "lamina/core/bevel.hpp"
 
+#include "bevel_gouge.hpp"
 #include "clipper_bridge.hpp"
 #include "lamina/core/section_lines.hpp"
 #include "lamina/core/slice.hpp"
@@ -463,6 +464,11 @@ LayerPlan plan_layer(const Mesh& mesh, const LayerSpan& span, int index, const s
     plan.passes = std::max(plan.passes, static_cast<int>(pass_count));
     plan.max_deviation_mm = std::max(plan.max_deviation_mm, outline.max_deviation_mm);
     plan.outlines.push_back(std::move(outline));
+  }
+  if (params.fit.side == CutSide::outside) {
+    const detail::GougeClearance g = detail::clear_gouges(plan, sub_slices, reach);
+    plan.gouge_shift_mm = g.largest_shift_mm;
+    plan.gouge_left_mm = g.worst_left_mm;
   }
   plan.within_tolerance = plan.max_deviation_mm <= params.tolerance_mm;
   return plan;

@@ -113,10 +113,9 @@ std::expected<Deviation, Error> measure_deviation(const Mesh& mesh, const BevelP
     z_hi = std::max(z_hi, layer.z_top_mm());
   }
   const double steps = std::ceil((z_hi - z_lo) / params.step_mm);
-  constexpr double kMaxSteps = 4e6;
-  if (steps > kMaxSteps)
+  if (steps > kMaxDeviationSections)
     return bad(fmt::format("measure_deviation: {:.4g} mm at step {} mm is more than {:.0f} sections", z_hi - z_lo,
-                           params.step_mm, kMaxSteps));
+                           params.step_mm, kMaxDeviationSections));
   const auto n_steps = std::max<std::size_t>(1, static_cast<std::size_t>(steps));
   std::vector<double> breaks;
   breaks.reserve(n_steps + 1 + 2 * plan.layers.size());

@@ -271,10 +271,16 @@ ContourVector Slice::vector(const Mesh& mesh, std::size_t loop, std::size_t inde
   return v;
 }
 
+double planes_by_step(double height_mm, double step_mm) {
+  if (!(step_mm > 0.0) || !(height_mm > 0.0)) return 0.0;
+  return std::floor(height_mm / step_mm + 0.5);
+}
+
 std::vector<double> heights_by_step(double height_mm, double step_mm) {
   std::vector<double> zs;
-  if (!(step_mm > 0.0) || !(height_mm > 0.0)) return zs;
-  const auto count = static_cast<std::size_t>(std::floor(height_mm / step_mm + 0.5));
+  const double planes = planes_by_step(height_mm, step_mm);
+  if (!(planes <= static_cast<double>(kMaxSlicePlanes))) return zs;
+  const auto count = static_cast<std::size_t>(planes);
   zs.reserve(count);
   for (std::size_t i = 0; i < count; ++i) zs.push_back((static_cast<double>(i) + 0.5) * step_mm);
   return zs;
@@ -283,6 +289,9 @@ std::vector<double> heights_by_step(double height_mm, double step_mm) {
 std::expected<std::vector<Slice>, Error> slice_mesh(const Mesh& mesh, std::span<const double> zs,
                                                     const SliceParams& params) {
   if (mesh.faces.empty()) return std::unexpected(Error{ErrorCode::empty_mesh, "slice: the mesh has no facets"});
+  if (zs.size() > kMaxSlicePlanes)
+    return std::unexpected(Error{ErrorCode::invalid_argument,
+                                 fmt::format("slice: {} planes asked for, at most {}", zs.size(), kMaxSlicePlanes)});
   for (std::size_t i = 0; i < zs.size(); ++i)
     if (!std::isfinite(zs[i]))
       return std::unexpected(Error{ErrorCode::invalid_argument, fmt::format("slice: height #{} is not finite", i)});

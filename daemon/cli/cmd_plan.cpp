@@ -2,10 +2,12 @@
 // of the same layering cut three ways (vertical, sloped, curved), DIR/stack.stl and DIR/report.json.
 #include "commands.hpp"
 #include "plan_cam.hpp"
+#include "plan_output.hpp"
 #include "plan_options.hpp"
 #include "plan_progress.hpp"
 #include "plan_report.hpp"
 
+#include "lamina/core/deviation.hpp"
 #include "lamina/core/stack_mesh.hpp"
 
 #include <fmt/format.h>
@@ -34,21 +36,6 @@ int report_error(const Error& e, int exit_code = 1) {
   return exit_code;
 }
 
-// DIR exists (created if missing) and we may write into it; checked before any planning so a
-// typo in --out does not cost a full plan.
-std::expected<fs::path, Error> prepare_out_dir(const std::string& dir) {
-  std::error_code ec;
-  if (fs::exists(dir, ec) && !fs::is_directory(dir, ec))
-    return std::unexpected(Error{ErrorCode::io_error, fmt::format("--out {}: exists and is not a folder", dir)});
-  fs::create_directories(dir, ec);
-  if (ec)
-    return std::unexpected(
-        Error{ErrorCode::io_error, fmt::format("--out {}: cannot create the folder: {}", dir, ec.message())});
-  if (::access(dir.c_str(), W_OK | X_OK) != 0)
-    return std::unexpected(Error{ErrorCode::io_error, fmt::format("--out {}: not writable: {}", dir, std::strerror(errno))});
-  return fs::path(dir);
-}
-
 // What the layering and the plan leave for a person to decide: layers over tolerance, and layers
 // that do not fit any sheet of their thickness whose size is known.
 void add_plan_warnings(const PlanSettings& settings, const BevelPlan& plan, std::vector<std::string>& warnings) {
@@ -62,6 +49,14 @@ void add_plan_warnings(const PlanSettings& settings, const BevelPlan& plan, std:
   if (worst)
     warnings.push_back(fmt::format("{} layer(s) exceed the tolerance of {} mm (worst: layer {}, {:.3f} mm)", over,
                                    settings.tolerance_mm, worst->index, worst->max_deviation_mm));
+
+  // Outside cuts that still take part material where the stations could not move far enough
+  // (issue 17, item 1): said per layer, with the depth.
+  for (const LayerPlan& l : plan.layers)
+    if (l.gouge_left_mm > 1e-3)
+      warnings.push_back(fmt::format("layer {} (z {:.3f}–{:.3f} mm): the cuts take up to {:.3f} mm of the part where a "
+                                     "sharp corner slides across the layer; stations were moved out by up to {:.3f} mm",
+                                     l.index, l.z_bottom_mm, l.z_top_mm(), l.gouge_left_mm, l.gouge_shift_mm));
 
   for (const LayerPlan& l : plan.layers) {
     double x0 = 1e300, y0 = 1e300, x1 = -1e300, y1 = -1e300;
@@ -92,27 +87,41 @@ std::string stl_header(const PlanOptions& o, const PlanResult& r) {
   return h;
 }
 
-// Sheet files of an earlier run that this run will not rewrite must not be mistaken for its own.
-void remove_old_sheet_files(const fs::path& dir) {
-  std::error_code ec;
-  for (const auto& entry : fs::directory_iterator(dir, ec)) {
-    const std::string name = entry.path().filename().string();
-    if (name.starts_with("sheet-") && (name.ends_with(".nc") || name.ends_with(".svg"))) fs::remove(entry.path(), ec);
-  }
+// A parameter the model makes absurd is a usage error (exit 2), found before any work (issue 17,
+// item 7): the layering checks its own grid and stock at once; the deviation's sections are
+// counted here, not after the layering and bevels have run.
+std::expected<void, Error> check_against_model(const PlanSettings& s, const Mesh& mesh) {
+  const double height = mesh.summary.bbox_max_mm.z() - mesh.summary.bbox_min_mm.z();
+  const double sections = std::ceil(height / s.deviation_step_mm);
+  if (sections > kMaxDeviationSections)
+    return std::unexpected(Error{ErrorCode::invalid_argument,
+                                 fmt::format("--deviation-step {} mm gives {:.3g} sections over the model's {:.3f} mm, "
+                                             "more than {:.0f}: give --deviation-step {:.3g} mm or more",
+                                             s.deviation_step_mm, sections, height, kMaxDeviationSections,
+                                             height / kMaxDeviationSections)});
+  return {};
+}
+
+int exit_code_of(const Error& e) { return e.code == ErrorCode::invalid_argument ? 2 : 1; }
+
+// Sheet files of an earlier run that this run does not rewrite must not be mistaken for its own.
+bool is_sheet_file(const std::string& name) {
+  return name.starts_with("sheet-") && (name.ends_with(".nc") || name.ends_with(".svg"));
 }
 
 int run_plan(const PlanOptions& o, const CamOptions& cam_options) {
   const auto t_start = Clock::now();
   auto settings = resolve_plan_settings(o);
-  if (!settings) return report_error(settings.error(), settings.error().code == ErrorCode::invalid_argument ? 2 : 1);
+  if (!settings) return report_error(settings.error(), exit_code_of(settings.error()));
   std::optional<CamSettings> cam_settings;
   if (!cam_options.no_programs) {
     auto c = resolve_cam_settings(cam_options);
-    if (!c) return report_error(c.error(), c.error().code == ErrorCode::invalid_argument ? 2 : 1);
+    if (!c) return report_error(c.error(), exit_code_of(c.error()));
     cam_settings = std::move(*c);
   }
-  auto dir = prepare_out_dir(o.out_dir);
-  if (!dir) return report_error(dir.error());
+  // A typo in --out must not cost a full plan; nothing is created before the plan is whole.
+  if (auto ok = check_out_dir(o.out_dir); !ok) return report_error(ok.error());
+  const fs::path dir(o.out_dir);
   PlanProgress progress(o.progress_fd, cam_settings ? 7 : 5);
 
   progress.phase("reading the model");
@@ -128,12 +137,13 @@ int run_plan(const PlanOptions& o, const CamOptions& cam_options) {
                          fmt::format("{} is not usable as a solid (see lamina check {})", o.model.path, o.model.path)});
   r.timing.read = model->read_s;
   r.timing.topology = model->topology_s;
+  if (auto ok = check_against_model(*settings, mesh); !ok) return report_error(ok.error(), exit_code_of(ok.error()));
 
   progress.phase("choosing layers");
   auto t0 = Clock::now();
   auto layering = choose_layers(mesh, layering_params(*settings));
   r.timing.layering = seconds_since(t0);
-  if (!layering) return report_error(layering.error());
+  if (!layering) return report_error(layering.error(), exit_code_of(layering.error()));
   r.layering = std::move(*layering);
   r.warnings.insert(r.warnings.end(), r.layering.warnings.begin(), r.layering.warnings.end());
 
@@ -161,19 +171,14 @@ int run_plan(const PlanOptions& o, const CamOptions& cam_options) {
   }
   r.timing.deviation = seconds_since(t0);
 
+  // Every file is made in memory first: a failure in nesting or posting writes nothing.
   progress.phase("writing the stack");
   t0 = Clock::now();
   const std::string stl = binary_stl_bytes(stack_mesh(r.plan), stl_header(o, r));
-  // A report.json left from an earlier run must not sit next to the new stack.stl.
-  std::error_code ec;
-  fs::remove(*dir / "report.json", ec);
-  if (auto w = write_file_atomically(*dir, "stack.stl", stl); !w)
-    return report_error({ErrorCode::io_error, w.error()});
   r.timing.write = seconds_since(t0);
 
   // Parts, nesting, toolpaths, programs and drawings, one of each per sheet.
   std::optional<CamResult> cam;
-  remove_old_sheet_files(*dir);
   if (cam_settings) {
     progress.phase("nesting and programs");
     const Stock stock = sized_stock(settings->stock, cam_settings->machine, r.warnings);
@@ -182,13 +187,16 @@ int run_plan(const PlanOptions& o, const CamOptions& cam_options) {
     cam = std::move(*c);
     r.warnings.insert(r.warnings.end(), cam->warnings.begin(), cam->warnings.end());
     progress.phase("writing sheets");
-    t0 = Clock::now();
-    for (const SheetOutput& s : cam->sheets) {
-      for (const auto& [name, bytes] : {std::pair{s.program_name, &s.program.text}, std::pair{s.svg_name, &s.svg}})
-        if (auto w = write_file_atomically(*dir, name, *bytes); !w) return report_error({ErrorCode::io_error, w.error()});
-    }
-    r.timing.write += seconds_since(t0);
   }
+  t0 = Clock::now();
+  auto out = StagedOutput::open(o.out_dir);
+  if (!out) return report_error(out.error());
+  if (auto w = out->stage("stack.stl", stl); !w) return report_error(w.error());
+  if (cam)
+    for (const SheetOutput& s : cam->sheets)
+      for (const auto& [name, bytes] : {std::pair{s.program_name, &s.program.text}, std::pair{s.svg_name, &s.svg}})
+        if (auto w = out->stage(name, *bytes); !w) return report_error(w.error());
+  r.timing.write += seconds_since(t0);
   r.timing.total = seconds_since(t_start);
 
   nlohmann::ordered_json report = plan_report_json(o, *settings, *model, r);
@@ -196,8 +204,8 @@ int run_plan(const PlanOptions& o, const CamOptions& cam_options) {
     report["cam"] = cam_json(*cam_settings, *cam);
     report["sheets"] = sheets_json(*cam);
   }
-  if (auto w = write_file_atomically(*dir, "report.json", report.dump(2) + "\n"); !w)
-    return report_error({ErrorCode::io_error, w.error()});
+  if (auto w = out->stage("report.json", report.dump(2) + "\n"); !w) return report_error(w.error());
+  if (auto w = out->publish(is_sheet_file); !w) return report_error(w.error());
   progress.done();
 
   if (o.json) {
@@ -206,9 +214,9 @@ int run_plan(const PlanOptions& o, const CamOptions& cam_options) {
     print_plan_tables(stdout, report, o.all_rows);
     fmt::print("\n");
     print_sheet_table(stdout, report);
-    fmt::print("wrote {} ({} bytes), {}", (*dir / "stack.stl").string(), stl.size(), (*dir / "report.json").string());
+    fmt::print("wrote {} ({} bytes), {}", (dir / "stack.stl").string(), stl.size(), (dir / "report.json").string());
     if (cam && !cam->sheets.empty())
-      fmt::print(", and {} program(s) + drawing(s) {}/sheet-<n>.nc, .svg", cam->sheets.size(), dir->string());
+      fmt::print(", and {} program(s) + drawing(s) {}/sheet-<n>.nc, .svg", cam->sheets.size(), dir.string());
     fmt::print("\n");
   }
   std::fflush(stdout);  // warnings after the tables they refer to, even when both go to one pipe

@@ -87,7 +87,19 @@ void add_slice_command(CLI::App& app, int& exit_code) {
 
     const double height = model->mesh.summary.bbox_max_mm.z();
     std::vector<double> zs;
-    if (step->count()) zs = heights_by_step(height, o->step_mm);
+    if (step->count()) {
+      // Bounded by the model: the plane count is known only once its height is.
+      const double planes = planes_by_step(height, o->step_mm);
+      if (planes > static_cast<double>(kMaxSlicePlanes)) {
+        fmt::print(stderr,
+                   "error [invalid_argument]: --step {} mm gives {:.3g} planes over the model's {:.3f} mm, more than "
+                   "{}: give --step {:.3g} mm or more\n",
+                   o->step_mm, planes, height, kMaxSlicePlanes, height / static_cast<double>(kMaxSlicePlanes));
+        exit_code = 2;
+        return;
+      }
+      zs = heights_by_step(height, o->step_mm);
+    }
     for (double z : o->at_mm) {
       if (z < 0.0 || z > height) fmt::print(stderr, "warning: z={} mm is outside the model (0 … {:.4f} mm)\n", z, height);
       zs.push_back(z);

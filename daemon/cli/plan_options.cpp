@@ -111,7 +111,9 @@ void add_plan_options(CLI::App& cmd, PlanOptions& o) {
   cmd.footer(
       "All plan lengths (--stock, --bond, --sub-slice, --tolerance, --deviation-step) are in mm and\n"
       "--tilt-max in degrees, whatever --units says: --units is the unit of the model file only.\n"
-      "Exit status: 0 planned, 1 the model, the stock file or the output folder failed, 2 usage error.");
+      "Exit status: 0 planned, 1 the model, the stock file, nesting or the output folder failed, 2 usage error\n"
+      "(also a value the model makes absurd: a sheet thicker than the part, a grid too fine for its height).\n"
+      "A run that fails leaves --out as it found it.");
 }
 
 std::expected<PlanSettings, Error> resolve_plan_settings(const PlanOptions& o) {

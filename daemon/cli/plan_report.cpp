@@ -2,11 +2,7 @@
 
 #include <fmt/format.h>
 
-#include <cerrno>
-#include <cstring>
-#include <fcntl.h>
 #include <map>
-#include <unistd.h>
 
 namespace lamina::cli {
 namespace {
@@ -55,6 +51,8 @@ Json layer_json(const LayerPlan& l, const LayerSpan* span) {
           {"passes", l.passes},
           {"max_deviation_mm", l.max_deviation_mm},
           {"within_tolerance", l.within_tolerance},
+          {"gouge_shift_mm", l.gouge_shift_mm},
+          {"gouge_left_mm", l.gouge_left_mm},
           {"estimated_deviation_mm", span ? Json(span->estimated_deviation_mm) : Json(nullptr)},
           {"outlines", l.outlines.size()},
           {"stations", stations},
@@ -175,41 +173,6 @@ void print_plan_tables(std::FILE* out, const nlohmann::ordered_json& report, boo
              t.at("read").get<double>(), t.at("topology").get<double>(), t.at("layering").get<double>(),
              t.at("bevel").get<double>(), t.at("deviation").get<double>(), t.at("write").get<double>(),
              t.at("total").get<double>());
-}
-
-std::expected<void, std::string> write_file_atomically(const std::filesystem::path& dir, const std::string& name,
-                                                       std::string_view bytes) {
-  const std::filesystem::path tmp = dir / ("." + name + ".tmp");
-  const std::filesystem::path final_path = dir / name;
-  const auto fail = [&](const char* what) {
-    const int err = errno;
-    ::unlink(tmp.c_str());
-    return std::unexpected(fmt::format("cannot write {}: {} ({})", final_path.string(), std::strerror(err), what));
-  };
-  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd < 0) return std::unexpected(fmt::format("cannot write {}: {}", final_path.string(), std::strerror(errno)));
-  for (std::size_t done = 0; done < bytes.size();) {
-    const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) {
-      ::close(fd);
-      return fail("write");
-    }
-    done += static_cast<std::size_t>(n);
-  }
-  if (::fsync(fd) != 0) {
-    ::close(fd);
-    return fail("fsync");
-  }
-  if (::close(fd) != 0) return fail("close");
-  if (::rename(tmp.c_str(), final_path.c_str()) != 0) return fail("rename");
-  // Make the rename itself durable.
-  const int dfd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (dfd >= 0) {
-    ::fsync(dfd);
-    ::close(dfd);
-  }
-  return {};
 }
 
 }  // namespace lamina::cli

@@ -1,7 +1,7 @@
 #pragma once
 // What `lamina plan` hands back: report.json (built here from the plan, keys in reading order),
-// the tables a person reads (printed from that same JSON, so both always agree), and the atomic
-// file writes of DIR.
+// the tables a person reads (printed from that same JSON, so both always agree). The files of DIR
+// are written by plan_output.hpp.
 #include "lamina/core/bevel.hpp"
 #include "lamina/core/deviation.hpp"
 #include "lamina/core/layering.hpp"
@@ -41,9 +41,5 @@ nlohmann::ordered_json plan_report_json(const PlanOptions& options, const PlanSe
 
 // The layer table, the deviation table, the stack line, shortfalls, warnings and timings.
 void print_plan_tables(std::FILE* out, const nlohmann::ordered_json& report, bool all_rows);
-
-// Writes dir/.name.tmp, flushes it to disk, renames it to dir/name: readers never see a half file.
-std::expected<void, std::string> write_file_atomically(const std::filesystem::path& dir, const std::string& name,
-                                                       std::string_view bytes);
 
 }  // namespace lamina::cli

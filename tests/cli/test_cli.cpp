@@ -115,6 +115,18 @@ TEST(Cli, UsageErrorsAreRejected) {
   EXPECT_NE(lamina("slice " + quoted(kKnob) + " --at-fraction 1.5").exit_code, 0);
 }
 
+// Issue 17, item 7: `--step 1e-9` asked for 3·10^10 planes and died in std::bad_alloc. A step the
+// model makes absurd is a usage error (exit 2) naming the smallest step that works.
+TEST(Cli, SliceStepTooFineForTheModelIsAUsageError) {
+  for (const char* step : {"1e-9", "1e-4"}) {
+    const CliRun r = lamina("slice " + quoted(kKnob) + " --step " + step);
+    EXPECT_EQ(r.exit_code, 2) << step << ":\n" << r.out;
+    EXPECT_NE(r.out.find("planes over the model's"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("give --step"), std::string::npos) << r.out;
+  }
+  EXPECT_EQ(lamina("slice " + quoted(kKnob) + " --step 0.01").exit_code, 0) << "a fine step within bounds still slices";
+}
+
 TEST(Cli, SliceJsonHoldsMeshSlicesVectorsAndTimings) {
   const fs::path json_path = temp_file("knob.json");
   const CliRun r = lamina("slice " + quoted(kKnob) + " --at-fraction 0.25,0.5,0.75 --json " + quoted(json_path));

@@ -10,6 +10,7 @@
 #include <fstream>
 #include <set>
 #include <string>
+#include <tuple>
 #include <vector>
 
 namespace {
@@ -240,16 +241,21 @@ TEST(CliPlan, StockFileErrorsNameTheKeyAndLine) {
 }
 
 // Issue 16, item 11: `--stock 1e10` crashed the planner (SIGSEGV), `--stock 0.001` took 2.6 GB,
-// `--stock-file /dev/zero` grew without end. Each is a clear error (exit 1) before any work.
+// `--stock-file /dev/zero` grew without end. Each is a clear error before any work: a value the
+// model makes absurd is a usage error (exit 2, issue 17 item 7), an unreadable file exit 1.
 TEST(CliPlan, StockTheModelCannotUseIsAClearErrorNotACrash) {
   TempDir out("plan-absurd-stock");
   const std::string base = "plan " + quoted(kKnob) + " --out " + quoted(out.path) + " ";
-  for (const auto& [arg, fragment] : std::vector<std::pair<std::string, std::string>>{
-           {"--stock 1e10", "every stock sheet is thicker than the part"},
-           {"--stock 0.001", "thinner than half the sub-slice spacing"},
-           {"--stock-file /dev/zero", "stock file /dev/zero is not a regular file"}}) {
+  for (const auto& [arg, fragment, code] : std::vector<std::tuple<std::string, std::string, int>>{
+           {"--stock 1e10", "every stock sheet is thicker than the part", 2},
+           {"--stock 1e9", "every stock sheet is thicker than the part", 2},
+           {"--stock 1000", "every stock sheet is thicker than the part", 2},
+           {"--stock 0.001", "thinner than half the sub-slice spacing", 2},
+           {"--sub-slice 1e-6 --stock 1", "grid lines", 2},
+           {"--deviation-step 1e-9", "--deviation-step 1e-09 mm gives", 2},
+           {"--stock-file /dev/zero", "stock file /dev/zero is not a regular file", 1}}) {
     const CliRun r = lamina(base + arg);
-    EXPECT_EQ(r.exit_code, 1) << arg << ":\n" << r.out;
+    EXPECT_EQ(r.exit_code, code) << arg << ":\n" << r.out;
     EXPECT_TRUE(has_text(r, fragment)) << arg << ": expected " << fragment << " in:\n" << r.out;
   }
   EXPECT_FALSE(fs::exists(out.path / "report.json"));

@@ -67,6 +67,11 @@ struct LayerPlan {
   int passes = 0;                       // largest pass count of its outlines
   double max_deviation_mm = 0.0;        // largest station deviation (profile plane), mm
   bool within_tolerance = true;
+  // Outside cuts moved off material their chords took between stations (issue 17, item 1: a
+  // sharp corner on a sloped face): the largest move of a station, and the deepest sub-slice
+  // material still outside the cuts afterwards (0 when all was cleared). Both mm.
+  double gouge_shift_mm = 0.0;
+  double gouge_left_mm = 0.0;
   // Stations per shape, indexed by ProfileShape.
   std::array<int, 5> shape_counts{};
 

@@ -65,7 +65,15 @@ struct SliceParams {
 std::expected<std::vector<Slice>, Error> slice_mesh(const Mesh& mesh, std::span<const double> zs,
                                                     const SliceParams& params);
 
+// More planes than this in one call is a mistake in the parameters (a 1e-9 mm step over 30 mm
+// asked for 3·10^10 and died in std::bad_alloc, issue 17 item 7): slice_mesh refuses them.
+inline constexpr std::size_t kMaxSlicePlanes = 100'000;
+
+// How many planes heights_by_step gives (checked against kMaxSlicePlanes before making them).
+double planes_by_step(double height_mm, double step_mm);
+
 // Heights for "--step h": h/2, 3h/2, ... below the top (mid-layer planes avoid the flat ends).
+// Empty for a step that gives more than kMaxSlicePlanes planes.
 std::vector<double> heights_by_step(double height_mm, double step_mm);
 
 }  // namespace lamina
