@@ -137,6 +137,9 @@ int run_plan(const PlanOptions& o, const CamOptions& cam_options) {
                          fmt::format("{} is not usable as a solid (see lamina check {})", o.model.path, o.model.path)});
   r.timing.read = model->read_s;
   r.timing.topology = model->topology_s;
+  const double sheet_longest_mm =
+      cam_settings ? std::max(cam_settings->machine.sheet_width_mm, cam_settings->machine.sheet_length_mm) : 2500.0;
+  if (auto note = implausible_size(mesh, o.model, sheet_longest_mm)) r.warnings.push_back(*note);
   if (auto ok = check_against_model(*settings, mesh); !ok) return report_error(ok.error(), exit_code_of(ok.error()));
 
   progress.phase("choosing layers");

@@ -2,6 +2,8 @@
 
 #include "lamina/core/mesh_io.hpp"
 
+#include <fmt/format.h>
+
 #include <chrono>
 #include <numbers>
 
@@ -38,6 +40,20 @@ std::expected<LoadedModel, Error> load_model(const ModelOptions& options) {
   if (!mesh) return std::unexpected(mesh.error());
   out.mesh = std::move(*mesh);
   return out;
+}
+
+std::optional<std::string> implausible_size(const Mesh& mesh, const ModelOptions& o, double sheet_longest_mm) {
+  const Eigen::Vector3d size = mesh.summary.bbox_max_mm - mesh.summary.bbox_min_mm;
+  const double largest = size.maxCoeff();
+  const std::string dims = fmt::format("{:.2f} × {:.2f} × {:.2f} mm", size.x(), size.y(), size.z());
+  if (o.units == "mm" && largest < kSmallestPlausiblePartMm)
+    return fmt::format("{}: the model is {} ({:.2f} mm at its largest): if the file is in inches, give --units in "
+                       "(it would be {:.1f} mm)", o.path, dims, largest, largest * 25.4);
+  if (o.units == "in" && largest > sheet_longest_mm)
+    return fmt::format("{}: with --units in the model is {}, larger than the {:.0f} mm sheet: if the file is in mm, "
+                       "give --units mm (it would be {:.1f} mm at its largest)", o.path, dims, sheet_longest_mm,
+                       largest / 25.4);
+  return std::nullopt;
 }
 
 }  // namespace lamina::cli

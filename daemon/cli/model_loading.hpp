@@ -3,6 +3,7 @@
 #include "lamina/core/mesh.hpp"
 
 #include <expected>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -30,5 +31,11 @@ struct LoadedModel {
 
 MeshParams mesh_params_from(const ModelOptions& options);
 std::expected<LoadedModel, Error> load_model(const ModelOptions& options);
+
+// A size that suggests the wrong --units (issue 17, item 8): a part under 10 mm at its largest
+// read as mm (an inch file: 25.4 times that), or a part larger than the sheet read as inches
+// (a mm file). Said, not refused: both can be meant.
+inline constexpr double kSmallestPlausiblePartMm = 10.0;
+std::optional<std::string> implausible_size(const Mesh& mesh, const ModelOptions& options, double sheet_longest_mm);
 
 }  // namespace lamina::cli

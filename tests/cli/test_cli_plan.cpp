@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <fstream>
 #include <set>
@@ -307,3 +308,44 @@ TEST(CliPlan, MissingModelIsAnIoError) {
 }
 
 }  // namespace
+
+namespace {
+
+// An ASCII STL of the box [0, x] × [0, y] × [0, z], outward facets.
+void write_box_stl(const fs::path& path, double x, double y, double z) {
+  const double c[8][3] = {{0, 0, 0}, {x, 0, 0}, {x, y, 0}, {0, y, 0}, {0, 0, z}, {x, 0, z}, {x, y, z}, {0, y, z}};
+  const int quads[6][4] = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}};
+  std::ofstream out(path);
+  out << "solid box\n";
+  for (const auto& q : quads)
+    for (const auto& tri : {std::array{q[0], q[1], q[2]}, std::array{q[0], q[2], q[3]}}) {
+      out << "facet normal 0 0 0\nouter loop\n";
+      for (int v : tri) out << "vertex " << c[v][0] << ' ' << c[v][1] << ' ' << c[v][2] << '\n';
+      out << "endloop\nendfacet\n";
+    }
+  out << "endsolid box\n";
+}
+
+}  // namespace
+
+// Issue 17, item 8: an inch file read as mm planned a 2.7 mm part without a word, and a mm file
+// given --units in a part larger than the sheet. Both are said (not refused: both can be meant).
+TEST(CliPlan, ASizeThatSuggestsTheWrongUnitsIsSaid) {
+  TempDir out("plan-units");
+  const fs::path tiny = temp_file("tiny-inch-part.stl"), plate = temp_file("mm-plate.stl");
+  write_box_stl(tiny, 2.7, 2.0, 2.5);
+  write_box_stl(plate, 120, 60, 1);
+  CliRun r = lamina("plan " + quoted(tiny) + " --stock 0.5,1 --sub-slice 0.25 --no-programs --out " + quoted(out.path));
+  EXPECT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_TRUE(has_text(r, "2.70 mm at its largest): if the file is in inches, give --units in (it would be 68.6 mm)"))
+      << r.out;
+  r = lamina("plan " + quoted(plate) + " --units in --stock 5,10 --no-programs --out " + quoted(out.path));
+  EXPECT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_TRUE(has_text(r, "larger than the 2500 mm sheet: if the file is in mm, give --units mm (it would be 120.0 mm"))
+      << r.out;
+  r = lamina("plan " + quoted(plate) + " --stock 0.5,1 --no-programs --out " + quoted(out.path));
+  EXPECT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_FALSE(has_text(r, "--units")) << "a 120 mm plate in mm is plausible:\n" << r.out;
+  fs::remove(tiny);
+  fs::remove(plate);
+}
