@@ -33,7 +33,9 @@ void add_check_command(CLI::App& app, int& exit_code) {
     fmt::print("  shells {}, surfaces {}, watertight {}\n", s.shells, s.surfaces, s.watertight ? "yes" : "no");
     for (const ReadNote& n : model->notes) fmt::print("  [note]     {}: {}\n", n.code, n.message);
     for (const Defect& d : model->mesh.defects) fmt::print("  [{}] {}: {}\n", severity_name(d.severity), d.code, d.message);
-    if (model->notes.empty() && model->mesh.defects.empty()) fmt::print("  no defects found\n");
+    const auto overlap = overlapping_shells(model->mesh);
+    if (overlap) fmt::print("  [warning] {}\n", *overlap);
+    if (model->notes.empty() && model->mesh.defects.empty() && !overlap) fmt::print("  no defects found\n");
     const bool usable = model->mesh.usable();
     fmt::print("{}\n", usable ? "usable" : "NOT usable as a solid");
     if (!json_path->empty()) {

@@ -140,6 +140,7 @@ int run_plan(const PlanOptions& o, const CamOptions& cam_options) {
   const double sheet_longest_mm =
       cam_settings ? std::max(cam_settings->machine.sheet_width_mm, cam_settings->machine.sheet_length_mm) : 2500.0;
   if (auto note = implausible_size(mesh, o.model, sheet_longest_mm)) r.warnings.push_back(*note);
+  if (auto note = overlapping_shells(mesh)) r.warnings.push_back(*note);
   if (auto ok = check_against_model(*settings, mesh); !ok) return report_error(ok.error(), exit_code_of(ok.error()));
 
   progress.phase("choosing layers");

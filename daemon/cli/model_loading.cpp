@@ -1,6 +1,7 @@
 #include "model_loading.hpp"
 
 #include "lamina/core/mesh_io.hpp"
+#include "lamina/core/slice.hpp"
 
 #include <fmt/format.h>
 
@@ -40,6 +41,26 @@ std::expected<LoadedModel, Error> load_model(const ModelOptions& options) {
   if (!mesh) return std::unexpected(mesh.error());
   out.mesh = std::move(*mesh);
   return out;
+}
+
+std::optional<std::string> overlapping_shells(const Mesh& mesh) {
+  if (mesh.summary.shells < 2) return std::nullopt;
+  const double z0 = mesh.summary.bbox_min_mm.z(), h = mesh.summary.bbox_max_mm.z() - z0;
+  std::vector<double> zs;
+  for (int i = 0; i < kShellProbePlanes; ++i) zs.push_back(z0 + h * (i + 0.5) / kShellProbePlanes);
+  SliceParams params;
+  params.parallel = false;
+  auto slices = slice_mesh(mesh, zs, params);
+  if (!slices) return std::nullopt;
+  int overlapping = 0;
+  double first_z = 0.0;
+  for (const Slice& sl : *slices)
+    for (const std::string& w : sl.warnings)
+      if (w.find("overlapping shells") != std::string::npos && overlapping++ == 0) first_z = sl.z_mm;
+  if (overlapping == 0) return std::nullopt;
+  return fmt::format("overlapping_shells: {} shells overlap in {} of {} sections (first at z = {:.3f} mm): the solid is "
+                     "their union; the volume above is their sum and counts the overlap more than once",
+                     mesh.summary.shells, overlapping, kShellProbePlanes, first_z);
 }
 
 std::optional<std::string> implausible_size(const Mesh& mesh, const ModelOptions& o, double sheet_longest_mm) {

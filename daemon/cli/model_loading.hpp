@@ -36,6 +36,12 @@ std::expected<LoadedModel, Error> load_model(const ModelOptions& options);
 // read as mm (an inch file: 25.4 times that), or a part larger than the sheet read as inches
 // (a mm file). Said, not refused: both can be meant.
 inline constexpr double kSmallestPlausiblePartMm = 10.0;
+// Shells that overlap (issue 17, item 8: a 9-shell OBJ passed `lamina check` without a word):
+// the solid is their union, and the summary's volume, a sum over shells, counts the overlap
+// more than once. Found by slicing at kShellProbePlanes heights; several shells only.
+inline constexpr int kShellProbePlanes = 64;
+std::optional<std::string> overlapping_shells(const Mesh& mesh);
+
 std::optional<std::string> implausible_size(const Mesh& mesh, const ModelOptions& options, double sheet_longest_mm);
 
 }  // namespace lamina::cli

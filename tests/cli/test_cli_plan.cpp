@@ -311,11 +311,13 @@ TEST(CliPlan, MissingModelIsAnIoError) {
 
 namespace {
 
-// An ASCII STL of the box [0, x] × [0, y] × [0, z], outward facets.
-void write_box_stl(const fs::path& path, double x, double y, double z) {
-  const double c[8][3] = {{0, 0, 0}, {x, 0, 0}, {x, y, 0}, {0, y, 0}, {0, 0, z}, {x, 0, z}, {x, y, z}, {0, y, z}};
+// An ASCII STL of the box [ox, ox + x] × [0, y] × [0, z], outward facets; `append` adds a
+// second solid to the file (a second shell).
+void write_box_stl(const fs::path& path, double x, double y, double z, double ox = 0, bool append = false) {
+  const double x0 = ox, x1 = ox + x;
+  const double c[8][3] = {{x0, 0, 0}, {x1, 0, 0}, {x1, y, 0}, {x0, y, 0}, {x0, 0, z}, {x1, 0, z}, {x1, y, z}, {x0, y, z}};
   const int quads[6][4] = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}};
-  std::ofstream out(path);
+  std::ofstream out(path, append ? std::ios::app : std::ios::trunc);
   out << "solid box\n";
   for (const auto& q : quads)
     for (const auto& tri : {std::array{q[0], q[1], q[2]}, std::array{q[0], q[2], q[3]}}) {
@@ -348,4 +350,26 @@ TEST(CliPlan, ASizeThatSuggestsTheWrongUnitsIsSaid) {
   EXPECT_FALSE(has_text(r, "--units")) << "a 120 mm plate in mm is plausible:\n" << r.out;
   fs::remove(tiny);
   fs::remove(plate);
+}
+
+// Issue 17, item 8: overlapping shells were not mentioned, and the volume is their sum. Two
+// 20 × 20 × 10 boxes, the second 10 mm along x: they share half their volume.
+TEST(CliPlan, OverlappingShellsAreSaidByCheckAndPlan) {
+  TempDir out("plan-shells");
+  const fs::path two = temp_file("two-boxes.stl"), apart = temp_file("two-boxes-apart.stl");
+  write_box_stl(two, 20, 20, 10);
+  write_box_stl(two, 20, 20, 10, 10, true);
+  write_box_stl(apart, 20, 20, 10);
+  write_box_stl(apart, 20, 20, 10, 30, true);
+  CliRun r = lamina("check " + quoted(two));
+  EXPECT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_TRUE(has_text(r, "overlapping_shells: 2 shells overlap in 64 of 64 sections")) << r.out;
+  r = lamina("plan " + quoted(two) + " --stock 5,10 --no-programs --out " + quoted(out.path));
+  EXPECT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_TRUE(has_text(r, "overlapping_shells")) << r.out;
+  r = lamina("check " + quoted(apart));
+  EXPECT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_FALSE(has_text(r, "overlapping_shells")) << "two shells side by side do not overlap:\n" << r.out;
+  fs::remove(two);
+  fs::remove(apart);
 }
