@@ -12,6 +12,7 @@ const char* error_code_name(ErrorCode code) {
     case ErrorCode::invalid_argument: return "invalid_argument";
     case ErrorCode::unsupported: return "unsupported";
     case ErrorCode::limit_exceeded: return "limit_exceeded";
+    case ErrorCode::stock_exhausted: return "stock_exhausted";
   }
   return "unknown";
 }

@@ -113,6 +113,38 @@ void add_stack_end_warnings(const Layering& out, double z_base, double thinnest,
                             params.tolerance_mm, std::abs(off), off > 0 ? "above" : "below"));
 }
 
+// Why the rack cannot make the stack (issue 17, item 5): each thickness it limits, by count or by
+// size, and how high the most it allows reaches.
+Error rack_error(const layering_detail::Estimator& est, const LayeringParams& params,
+                 const layering_detail::LayerChoice& choice) {
+  if (choice.state_limit)
+    return Error{ErrorCode::limit_exceeded,
+                 fmt::format("layering: the rack's sheet counts give more than {} combinations to search; leave the "
+                             "counts of plentiful thicknesses out of the stock file",
+                             layering_detail::kMaxDpStates)};
+  std::string limits;
+  for (std::size_t i = 0; i < est.thicknesses().size(); ++i) {
+    const double t = est.thicknesses()[i];
+    const ThicknessSupply* s = nullptr;
+    for (const ThicknessSupply& x : params.supply)
+      if (std::abs(x.thickness_mm - t) <= 1e-9) s = &x;
+    if (!s || (s->max_layers < 0 && s->rooms.empty())) continue;
+    std::string what = s->max_layers >= 0 ? fmt::format("at most {} layer(s)", s->max_layers) : "any number of layers";
+    if (!s->rooms.empty()) {
+      const auto big = std::max_element(s->rooms.begin(), s->rooms.end(), [](const auto& a, const auto& b) {
+        return a.length_mm * a.width_mm < b.length_mm * b.width_mm;
+      });
+      what += fmt::format(" no larger than {:.0f} x {:.0f} mm", big->length_mm, big->width_mm);
+    }
+    limits += fmt::format("{}{} mm: {}", limits.empty() ? "" : "; ", t, what);
+  }
+  return Error{ErrorCode::stock_exhausted,
+               fmt::format("layering: the rack cannot make a stack of the model's height ({:.3f} mm): the highest "
+                           "stack its sheets allow reaches {:.3f} mm ({}); add sheets to the stock or give more "
+                           "thicknesses",
+                           est.height(), choice.reached_mm, limits.empty() ? "no thickness fits" : limits)};
+}
+
 }  // namespace
 
 std::expected<Layering, Error> choose_layers(const Mesh& mesh, const LayeringParams& params) {
@@ -126,8 +158,10 @@ std::expected<Layering, Error> choose_layers(const Mesh& mesh, const LayeringPar
   layering_detail::Estimator& est = **created;
   const std::vector<double>& t = est.thicknesses();
 
-  const auto chosen = params.method == LayeringMethod::greedy ? layering_detail::layer_greedy(est, params)
+  const auto choice = params.method == LayeringMethod::greedy ? layering_detail::layer_greedy(est, params)
                                                                : layering_detail::layer_optimal(est, params);
+  if (choice.state_limit || choice.layers.empty()) return std::unexpected(rack_error(est, params, choice));
+  const auto& chosen = choice.layers;
   Layering out;
   out.model_height_mm = est.height();
   for (const auto& c : chosen) {

@@ -12,6 +12,10 @@
 // the thinnest sheet of the model's (or the nearest the stock allows), fewest layers out of
 // tolerance, then fewest layers, then least total estimated deviation, then the top nearest the
 // model's; remaining ties prefer thinner sheets higher up (thicker sheets lower in the stack).
+//
+// The rack (issue 17, item 5): a thickness is an edge only where the layer's outlines fit one of
+// its sheets, and only while its count allows (the state then carries the usage). When no stack
+// can end the model, the choice is empty and says how high the rack reaches.
 #include "layering_internal.hpp"
 
 #include <algorithm>
@@ -28,7 +32,7 @@ struct Node {
   int failed = 0;          // layers out of tolerance
   int count = 0;
   double deviation = 0.0;  // sum of the layers' estimates
-  std::int64_t pred = -1;  // key of the open state the last layer started from
+  std::pair<std::int64_t, std::int64_t> pred{-1, -1};  // (position, usage) the last layer started from
   ChosenLayer layer;       // the last layer
 };
 
@@ -60,35 +64,70 @@ const Node* best_final(const std::map<std::int64_t, Node>& finals, const Estimat
   return best;
 }
 
+// The edges from one position: for each thickness, its span, where its top would end the stack,
+// and its estimate (only what the rack allows is asked for).
+struct Reach {
+  std::vector<std::pair<GridSpan, int>> cands;
+  std::vector<double> dev;
+  std::vector<StackEnd> ends;
+  std::vector<char> fits;  // the layer's outlines fit a sheet of that thickness
+};
+
+void reach_from(Estimator& est, double z, double tol, Reach& r) {
+  const std::vector<double>& t = est.thicknesses();
+  for (std::size_t i = 0; i < t.size(); ++i) {
+    r.cands[i] = {est.span(z, t[i]), static_cast<int>(i)};
+    r.ends[i] = est.stack_end(z + t[i]);
+    r.fits[i] = est.fits_supply(r.cands[i].first, static_cast<int>(i));
+  }
+  // Failing layers may stop early (their value is not needed, unless none passes).
+  est.estimate(r.cands, r.dev, tol);
+}
+
 }  // namespace
 
-std::vector<ChosenLayer> layer_optimal(Estimator& est, const LayeringParams& params) {
+// States are (position, usage): the usage counts the layers taken of each thickness the rack
+// limits (SupplyCounter; 0 when none is limited, so the states are the positions alone).
+LayerChoice layer_optimal(Estimator& est, const LayeringParams& params) {
   const std::vector<double>& t = est.thicknesses();
   const double tol = params.tolerance_mm;
-  std::map<std::int64_t, Node> open, finals;
-  open.emplace(0, Node{});
+  const SupplyCounter supply(est);
+  LayerChoice out;
+  if (supply.too_many()) {
+    out.state_limit = true;
+    return out;
+  }
+  using Key = std::pair<std::int64_t, std::int64_t>;  // (position, usage)
+  std::map<Key, Node> open, finals_by_state;
+  std::map<std::int64_t, Node> finals;
+  open.emplace(Key{0, 0}, Node{});
 
-  std::vector<std::pair<GridSpan, int>> cands(t.size());
-  std::vector<double> dev(t.size());
-  std::vector<StackEnd> ends(t.size());
+  Reach r{std::vector<std::pair<GridSpan, int>>(t.size()), std::vector<double>(t.size()),
+          std::vector<StackEnd>(t.size()), std::vector<char>(t.size())};
+  std::int64_t reach_key = -1;
   for (auto it = open.begin(); it != open.end(); ++it) {
     const Node cur = it->second;
-    est.release_below(est.span(cur.z, t.front()).ka);
-    for (std::size_t i = 0; i < t.size(); ++i) {
-      cands[i] = {est.span(cur.z, t[i]), static_cast<int>(i)};
-      ends[i] = est.stack_end(cur.z + t[i]);
+    const auto [pos, usage] = it->first;
+    out.reached_mm = std::max(out.reached_mm, cur.z);
+    if (pos != reach_key) {  // states at one position share their edges' estimates
+      est.release_below(est.span(cur.z, t.front()).ka);
+      reach_from(est, cur.z, tol, r);
+      reach_key = pos;
     }
-    // Failing layers may stop early (their value is not needed) ...
-    est.estimate(cands, dev, tol);
+    auto usable = [&](std::size_t i) { return r.ends[i].allowed && r.fits[i] && supply.can_take(usage, static_cast<int>(i)); };
     bool any = false;
-    for (std::size_t i = 0; i < t.size(); ++i) any |= ends[i].allowed && dev[i] <= tol;
+    int thinnest = -1;
     for (std::size_t i = 0; i < t.size(); ++i) {
-      if (!ends[i].allowed) continue;
-      // ... unless none passes: then the thinnest is used and its deviation reported.
-      if (any ? dev[i] > tol : i != 0) continue;
-      const bool surface_ok = any;
-      double d = any ? dev[i] : est.estimate(cands[i].first, 0);
-      if (ends[i].final) d = std::max(d, ends[i].off_top_mm);
+      if (!usable(i)) continue;
+      any |= r.dev[i] <= tol;
+      if (thinnest < 0) thinnest = static_cast<int>(i);
+    }
+    for (std::size_t i = 0; i < t.size(); ++i) {
+      if (!usable(i)) continue;
+      // Only passing layers, unless none passes: then the thinnest usable, its deviation reported.
+      if (any ? r.dev[i] > tol : static_cast<int>(i) != thinnest) continue;
+      double d = any ? r.dev[i] : est.estimate(r.cands[i].first, static_cast<int>(i));
+      if (r.ends[i].final) d = std::max(d, r.ends[i].off_top_mm);
       const bool ok = d <= tol;
       const double top = cur.z + t[i];
       Node next;
@@ -96,20 +135,29 @@ std::vector<ChosenLayer> layer_optimal(Estimator& est, const LayeringParams& par
       next.count = cur.count + 1;
       next.deviation = cur.deviation + d;
       next.pred = it->first;
-      next.layer = ChosenLayer{cur.z, static_cast<int>(i), d, ok, surface_ok};
-      next.z = ends[i].final ? top : top + params.bond_mm;
-      auto& states = ends[i].final ? finals : open;
-      auto [slot, inserted] = states.try_emplace(key_of(next.z), next);
+      next.layer = ChosenLayer{cur.z, static_cast<int>(i), d, ok, any};
+      next.z = r.ends[i].final ? top : top + params.bond_mm;
+      const Key key{key_of(next.z), supply.take(usage, static_cast<int>(i))};
+      auto& states = r.ends[i].final ? finals_by_state : open;
+      auto [slot, inserted] = states.try_emplace(key, next);
       if (!inserted && better(next, slot->second, t)) slot->second = next;
     }
+    if (open.size() + finals_by_state.size() > kMaxDpStates) {
+      out.state_limit = true;
+      return out;
+    }
   }
-
-  std::vector<ChosenLayer> layers;
-  for (const Node* n = best_final(finals, est); n; n = n->pred >= 0 ? &open.at(n->pred) : nullptr) {
-    if (n->pred < 0) break;
-    layers.push_back(n->layer);
+  // Per final position, the best over usages (then best_final ranks the positions).
+  for (const auto& [key, n] : finals_by_state) {
+    auto [slot, inserted] = finals.try_emplace(key.first, n);
+    if (!inserted && better(n, slot->second, t)) slot->second = n;
   }
-  return {layers.rbegin(), layers.rend()};
+  const Node* best = best_final(finals, est);
+  if (!best) return out;
+  // Walk back: a final state's predecessors are open states, down to (0, 0).
+  for (const Node* n = best; n->pred.first >= 0; n = &open.at(n->pred)) out.layers.push_back(n->layer);
+  std::reverse(out.layers.begin(), out.layers.end());
+  return out;
 }
 
 }  // namespace lamina::layering_detail

@@ -103,6 +103,7 @@ std::expected<std::unique_ptr<Estimator>, Error> Estimator::create(const Mesh& m
   });
   e->compute_stations();
   e->compute_novelty();
+  e->compute_supply();
   e->cache_.resize(e->slices_.size());
   return e;
 }

@@ -111,6 +111,11 @@ class Estimator {
   // Positions only grow: caches of slices below grid line k are no longer needed.
   void release_below(int k);
 
+  // The supply (layering_supply.cpp): how many layers of a thickness the rack holds (-1: no
+  // limit), and whether every outer loop of a layer's sections fits one of its rooms.
+  int max_layers(int thickness_index) const { return max_layers_[static_cast<std::size_t>(thickness_index)]; }
+  bool fits_supply(GridSpan span, int thickness_index) const;
+
   const std::vector<std::string>& warnings() const { return warnings_; }
 
  private:
@@ -130,6 +135,7 @@ class Estimator {
   const Sample& sample(int station_slice, std::uint32_t station, int at_slice) const;
   void compute_stations();
   void compute_novelty();
+  void compute_supply();
 
   LayeringParams params_;
   std::vector<double> thicknesses_;
@@ -147,6 +153,10 @@ class Estimator {
   // above the line; its samples are read there (2δ higher) instead of querying it.
   std::vector<char> same_as_next_;
   std::vector<int> novel_list_;
+  std::vector<int> max_layers_;                // per thickness
+  // Per thickness with known rooms: prefix counts of slices with an outer loop no room takes
+  // (empty: every slice fits), so a span's check is one subtraction.
+  std::vector<std::vector<int>> misfit_prefix_;
   std::vector<SliceCache> cache_;
   int released_ = 0;                           // caches below this slice were dropped
   struct Memo {
@@ -166,7 +176,39 @@ struct ChosenLayer {
   bool surface_within = true;  // the same without the distance to the top (false: a shortfall)
 };
 
-std::vector<ChosenLayer> layer_optimal(Estimator& est, const LayeringParams& params);
-std::vector<ChosenLayer> layer_greedy(Estimator& est, const LayeringParams& params);
+// The layers of a method, bottom to top. Empty when the supply cannot make a stack that ends
+// the model (a limited count runs out first); reached_mm is then the highest top it allows.
+struct LayerChoice {
+  std::vector<ChosenLayer> layers;
+  double reached_mm = 0.0;
+  bool state_limit = false;  // the rack's counts gave more DP states than kMaxDpStates
+};
+
+// More (position, usage) states than this is a rack whose counts the DP cannot search.
+inline constexpr std::size_t kMaxDpStates = 4'000'000;
+
+// Layers used per limited thickness, as one number (mixed radix over the limited thicknesses),
+// so that a DP state is (position, usage) and the usage only grows.
+class SupplyCounter {
+ public:
+  explicit SupplyCounter(const Estimator& est);
+  bool limited() const { return !digit_.empty(); }
+  bool can_take(std::int64_t usage, int thickness_index) const;
+  std::int64_t take(std::int64_t usage, int thickness_index) const;
+  std::int64_t states() const { return states_; }  // distinct usages
+  bool too_many() const { return too_many_; }
+
+ private:
+  static constexpr std::int64_t kMaxUsageStates = std::int64_t{1} << 50;
+  std::vector<int> digit_of_;          // per thickness: its digit, -1 unlimited
+  std::vector<int> digit_;             // per digit: the thickness
+  std::vector<int> cap_;
+  std::vector<std::int64_t> radix_;
+  std::int64_t states_ = 1;
+  bool too_many_ = false;
+};
+
+LayerChoice layer_optimal(Estimator& est, const LayeringParams& params);
+LayerChoice layer_greedy(Estimator& est, const LayeringParams& params);
 
 }  // namespace lamina::layering_detail

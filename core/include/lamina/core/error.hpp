@@ -15,6 +15,7 @@ enum class ErrorCode : std::uint16_t {
   invalid_argument = 6,  // a parameter outside its domain
   unsupported = 7,       // a valid file using a feature we do not read
   limit_exceeded = 8,    // a file asking for more than a read limit allows (MeshReadOptions)
+  stock_exhausted = 9,   // the rack's sheets (counts, sizes) cannot make the plan
 };
 
 // Stable lower-case name of a code, e.g. "truncated_file".

@@ -17,8 +17,24 @@ namespace lamina {
 enum class LayeringMethod : std::uint8_t { optimal, greedy };
 const char* layering_method_name(LayeringMethod method);
 
+// What the rack can give of one thickness (issue 17, item 5): how many layers its sheets hold,
+// and the room each sheet size leaves a part (its usable length and width, after the sheet's
+// margins and the kerf). A layer is only cut from this thickness if every outer loop of its
+// sections fits one of those sizes (at 0° or 90°, as the nesting turns parts) — a necessary
+// condition: the nesting still has the last word.
+struct ThicknessSupply {
+  double thickness_mm = 0.0;
+  int max_layers = -1;  // -1: as many as needed
+  struct Room {
+    double length_mm = 0.0, width_mm = 0.0;
+  };
+  std::vector<Room> rooms;  // empty: the sizes are not known (no size check)
+};
+
 struct LayeringParams {
   std::vector<double> thicknesses_mm;  // stock thicknesses available (any order, > 0)
+  // Limits per thickness; a thickness not listed here is not limited.
+  std::vector<ThicknessSupply> supply;
   double bond_mm = 0.0;                // bonding gap between consecutive layers (adhesive)
   double sub_slice_mm = 0.5;           // z grid of the thin slices
   double tolerance_mm = 0.1;           // allowed achievable deviation per layer (optimal)
@@ -59,6 +75,9 @@ struct Layering {
   std::vector<std::string> warnings;
 };
 
+// Errors: invalid parameters (ErrorCode::invalid_argument), and a supply that cannot make a stack
+// of the model's height (ErrorCode::stock_exhausted, naming each limited thickness and how high
+// the most the stock allows reaches).
 std::expected<Layering, Error> choose_layers(const Mesh& mesh, const LayeringParams& params);
 
 }  // namespace lamina
