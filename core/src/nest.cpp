@@ -14,6 +14,7 @@
 #include <numbers>
 #include <functional>
 #include <optional>
+#include <set>
 #include <unordered_map>
 
 namespace lamina {
@@ -134,10 +135,30 @@ std::vector<detail::PackedSheet> pack(std::span<const Part> parts, std::span<con
   return detail::pack_matrix(parts, which, size, params, unplaced);
 }
 
+// How many layers of a group lost no part: `unplaced` are packed parts left over, and the parts
+// in their holes go with them.
+SheetShortage count_placed_layers(std::span<const Part> parts, std::span<const int> group, std::span<const int> unplaced,
+                                  const std::unordered_map<int, std::vector<const detail::HostedPart*>>& children) {
+  std::set<int> layers, lost;
+  for (int p : group) layers.insert(parts[p].layer_slot);
+  std::vector<int> todo(unplaced.begin(), unplaced.end());
+  while (!todo.empty()) {
+    const int p = todo.back();
+    todo.pop_back();
+    lost.insert(parts[p].layer_slot);
+    if (auto it = children.find(p); it != children.end())
+      for (const detail::HostedPart* h : it->second) todo.push_back(h->in_host.part);
+  }
+  SheetShortage s;
+  s.layers = static_cast<int>(layers.size());
+  s.layers_placed = s.layers - static_cast<int>(lost.size());
+  return s;
+}
+
 // The sheets of one thickness (numbered later), or the error naming the thickness.
 std::expected<std::vector<NestedSheet>, Error> nest_thickness(std::span<const Part> parts, std::span<const int> group,
                                                               double thickness, const Stock& stock,
-                                                              const NestParams& params) {
+                                                              const NestParams& params, SheetShortage& shortage) {
   auto bad = [](std::string m) { return std::unexpected(Error{ErrorCode::invalid_argument, std::move(m)}); };
   std::vector<int> entries;
   for (int i = 0; i < static_cast<int>(stock.sheets.size()); ++i)
@@ -249,15 +270,18 @@ std::expected<std::vector<NestedSheet>, Error> nest_thickness(std::span<const Pa
                      : std::string("more sheets of an earlier size needed");
     int left = 0;
     for (int p : remaining) left += carried(p);
-    return bad(fmt::format("nest: not enough {:g} mm sheets: {} in stock ({}), {} part(s) left over; {}", thickness,
-                           in_stock, stock_text, left, needed));
+    shortage = count_placed_layers(parts, group, remaining, children);
+    shortage.thickness_mm = thickness;
+    return std::unexpected(Error{ErrorCode::stock_exhausted, fmt::format("nest: not enough {:g} mm sheets: {} in stock ({}), {} part(s) left over; {}", thickness,
+                           in_stock, stock_text, left, needed)});
   }
   return out;
 }
 
 }  // namespace
 
-std::expected<Nest, Error> nest_parts(std::span<const Part> parts, const Stock& stock, const NestParams& params) {
+std::expected<Nest, Error> nest_parts(std::span<const Part> parts, const Stock& stock, const NestParams& params,
+                                      std::vector<SheetShortage>* shortages) {
   if (auto err = check_params(parts, params)) return std::unexpected(*err);
   // Thickness groups, ascending (thin sheets are cut first); parts keep input order in a group.
   std::vector<int> order(parts.size());
@@ -275,12 +299,18 @@ std::expected<Nest, Error> nest_parts(std::span<const Part> parts, const Stock& 
   }
   std::vector<std::expected<std::vector<NestedSheet>, Error>> results(
       groups.size(), std::unexpected(Error{ErrorCode::invalid_argument, ""}));
-  auto run = [&](std::size_t g) { results[g] = nest_thickness(parts, groups[g], thickness[g], stock, params); };
+  std::vector<SheetShortage> shortage(groups.size());
+  auto run = [&](std::size_t g) {
+    results[g] = nest_thickness(parts, groups[g], thickness[g], stock, params, shortage[g]);
+  };
   if (params.parallel && groups.size() > 1) {
     tbb::parallel_for(std::size_t{0}, groups.size(), run);
   } else {
     for (std::size_t g = 0; g < groups.size(); ++g) run(g);
   }
+  if (shortages)
+    for (std::size_t g = 0; g < groups.size(); ++g)
+      if (!results[g] && results[g].error().code == ErrorCode::stock_exhausted) shortages->push_back(shortage[g]);
   Nest nest;
   for (auto& r : results) {
     if (!r) return std::unexpected(r.error());  // the thinnest failing thickness

@@ -5,6 +5,7 @@
 #include "plan_output.hpp"
 #include "plan_options.hpp"
 #include "plan_progress.hpp"
+#include "plan_rack.hpp"
 #include "plan_report.hpp"
 
 #include "lamina/core/deviation.hpp"
@@ -109,6 +110,54 @@ bool is_sheet_file(const std::string& name) {
   return name.starts_with("sheet-") && (name.ends_with(".nc") || name.ends_with(".svg"));
 }
 
+// At most this many layouts of the stack against the rack: each lowers a thickness's count.
+constexpr int kMaxRackRounds = 16;
+
+// Layers, bevels and (unless --no-programs) parts, nesting and programs, fitted to the rack
+// (issue 17, item 5): a layer is only cut from sheets its outlines fit, and when the nesting runs
+// out of a thickness, that thickness is limited to the layers its sheets held and the stack is
+// laid out again, so the plan fits the rack or one error says which thickness runs out.
+// Returns 0, or the exit code after the error was said.
+int plan_on_rack(const Mesh& mesh, const PlanSettings& settings, const std::optional<CamSettings>& cam_settings,
+                 const std::optional<Stock>& stock, const std::string& title, std::vector<std::string> rack_warnings,
+                 PlanProgress& progress, PlanResult& r, std::optional<CamResult>& cam) {
+  LayeringParams params = layering_params(settings);
+  params.supply = cam_settings ? rack_supply(*stock, cam_settings->machine.nest.margin_mm, cam_settings->parts.kerf_mm)
+                               : rack_supply(settings.stock, 0.0, 0.0);
+  for (int round = 0;; ++round) {
+    if (round == 0) progress.phase("choosing layers");
+    auto t0 = Clock::now();
+    auto layering = choose_layers(mesh, params);
+    r.timing.layering += seconds_since(t0);
+    if (!layering) return report_error(layering.error(), exit_code_of(layering.error()));
+    r.layering = std::move(*layering);
+
+    if (round == 0) progress.phase("planning bevels");
+    t0 = Clock::now();
+    auto plan = plan_bevels(mesh, r.layering.layers, bevel_params(settings, settings.strategy));
+    r.timing.bevel += seconds_since(t0);
+    if (!plan) return report_error(plan.error());
+    r.plan = std::move(*plan);
+    if (!cam_settings) break;
+
+    if (round == 0) progress.phase("nesting and programs");
+    std::vector<SheetShortage> shortages;
+    auto c = plan_cam(r.plan, *stock, *cam_settings, title, &shortages);
+    if (c) {
+      cam = std::move(*c);
+      break;
+    }
+    if (c.error().code != ErrorCode::stock_exhausted || round + 1 >= kMaxRackRounds ||
+        !lower_rack_limits(params.supply, shortages, r.layering, *stock, rack_warnings))
+      return report_error(c.error());
+  }
+  r.warnings.insert(r.warnings.end(), r.layering.warnings.begin(), r.layering.warnings.end());
+  add_plan_warnings(settings, r.plan, r.warnings);
+  r.warnings.insert(r.warnings.end(), rack_warnings.begin(), rack_warnings.end());
+  if (cam) r.warnings.insert(r.warnings.end(), cam->warnings.begin(), cam->warnings.end());
+  return 0;
+}
+
 int run_plan(const PlanOptions& o, const CamOptions& cam_options) {
   const auto t_start = Clock::now();
   auto settings = resolve_plan_settings(o);
@@ -143,25 +192,17 @@ int run_plan(const PlanOptions& o, const CamOptions& cam_options) {
   if (auto note = overlapping_shells(mesh)) r.warnings.push_back(*note);
   if (auto ok = check_against_model(*settings, mesh); !ok) return report_error(ok.error(), exit_code_of(ok.error()));
 
-  progress.phase("choosing layers");
-  auto t0 = Clock::now();
-  auto layering = choose_layers(mesh, layering_params(*settings));
-  r.timing.layering = seconds_since(t0);
-  if (!layering) return report_error(layering.error(), exit_code_of(layering.error()));
-  r.layering = std::move(*layering);
-  r.warnings.insert(r.warnings.end(), r.layering.warnings.begin(), r.layering.warnings.end());
-
-  progress.phase("planning bevels");
-  t0 = Clock::now();
-  auto plan = plan_bevels(mesh, r.layering.layers, bevel_params(*settings, settings->strategy));
-  r.timing.bevel = seconds_since(t0);
-  if (!plan) return report_error(plan.error());
-  r.plan = std::move(*plan);
-  add_plan_warnings(*settings, r.plan, r.warnings);
+  std::optional<CamResult> cam;
+  std::optional<Stock> stock;
+  std::vector<std::string> stock_warnings;  // said after the layering's, before the sheets'
+  if (cam_settings) stock = sized_stock(settings->stock, cam_settings->machine, stock_warnings);
+  const std::string title = fs::path(o.model.path).filename().string();
+  if (int code = plan_on_rack(mesh, *settings, cam_settings, stock, title, std::move(stock_warnings), progress, r, cam))
+    return code;
 
   // The same layering cut three ways; the chosen strategy's plan is reused, not recomputed.
   progress.phase("measuring deviation");
-  t0 = Clock::now();
+  auto t0 = Clock::now();
   for (const BevelStrategy s : {BevelStrategy::vertical, BevelStrategy::sloped, BevelStrategy::curved}) {
     std::optional<BevelPlan> other;
     if (s != settings->strategy) {
@@ -175,23 +216,12 @@ int run_plan(const PlanOptions& o, const CamOptions& cam_options) {
   }
   r.timing.deviation = seconds_since(t0);
 
-  // Every file is made in memory first: a failure in nesting or posting writes nothing.
+  // Every file is made in memory first: a failure anywhere writes nothing.
   progress.phase("writing the stack");
   t0 = Clock::now();
   const std::string stl = binary_stl_bytes(stack_mesh(r.plan), stl_header(o, r));
   r.timing.write = seconds_since(t0);
-
-  // Parts, nesting, toolpaths, programs and drawings, one of each per sheet.
-  std::optional<CamResult> cam;
-  if (cam_settings) {
-    progress.phase("nesting and programs");
-    const Stock stock = sized_stock(settings->stock, cam_settings->machine, r.warnings);
-    auto c = plan_cam(r.plan, stock, *cam_settings, fs::path(o.model.path).filename().string());
-    if (!c) return report_error(c.error());
-    cam = std::move(*c);
-    r.warnings.insert(r.warnings.end(), cam->warnings.begin(), cam->warnings.end());
-    progress.phase("writing sheets");
-  }
+  if (cam) progress.phase("writing sheets");
   t0 = Clock::now();
   auto out = StagedOutput::open(o.out_dir);
   if (!out) return report_error(out.error());

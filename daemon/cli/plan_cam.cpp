@@ -116,7 +116,7 @@ Stock sized_stock(const Stock& stock, const MachineConfig& machine, std::vector<
 }
 
 std::expected<CamResult, Error> plan_cam(const BevelPlan& plan, const Stock& stock, const CamSettings& settings,
-                                         const std::string& title) {
+                                         const std::string& title, std::vector<SheetShortage>* shortages) {
   CamResult r;
   const MachineConfig& m = settings.machine;
   auto t0 = Clock::now();
@@ -126,7 +126,7 @@ std::expected<CamResult, Error> plan_cam(const BevelPlan& plan, const Stock& sto
   r.timing.parts = seconds_since(t0);
 
   t0 = Clock::now();
-  auto nest = nest_parts(r.parts, stock, m.nest);
+  auto nest = nest_parts(r.parts, stock, m.nest, shortages);
   if (!nest) return std::unexpected(nest.error());
   r.timing.nest = seconds_since(t0);
 

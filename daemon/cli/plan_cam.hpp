@@ -69,8 +69,10 @@ struct CamResult {
   std::vector<std::string> warnings;
 };
 
+// When the rack runs out of sheets (ErrorCode::stock_exhausted), `shortages` (if given) says
+// which thicknesses and how many of their layers were placed whole.
 std::expected<CamResult, Error> plan_cam(const BevelPlan& plan, const Stock& stock, const CamSettings& settings,
-                                         const std::string& title);
+                                         const std::string& title, std::vector<SheetShortage>* shortages = nullptr);
 
 // report.json's "sheets" and "cam" members.
 nlohmann::ordered_json sheets_json(const CamResult& r);

@@ -52,8 +52,8 @@ class PlanFailures : public ::testing::Test {
     fs::remove_all(root_);
     fs::create_directories(root_ / "model-folder");
     write(root_ / "empty.stl", "");
-    // A rack whose sheets are far smaller than the knob: the layering and the stack succeed,
-    // nesting fails.
+    // A rack whose sheets are far smaller than the knob: the layering finds no sheet its
+    // layers fit (issue 17, item 5: before, the stack succeeded and nesting failed).
     write(root_ / "tiny-rack.toml",
           "[[sheet]]\nthickness_mm = 1.0\nwidth_mm = 20\nlength_mm = 20\ncount = 1\n"
           "[[sheet]]\nthickness_mm = 5.0\nwidth_mm = 20\nlength_mm = 20\ncount = 1\n");
@@ -70,7 +70,7 @@ class PlanFailures : public ::testing::Test {
         {"a sub-slice with too many grid lines", knob + " --sub-slice 1e-6 --stock 1 --out {out}", 2},
         {"a deviation step too fine", knob + " --deviation-step 1e-7 --out {out}", 2},
         {"a bad stock list", knob + " --stock 1,,2 --out {out}", 2},
-        {"nesting that cannot place the layers", knob + " --stock-file " + quoted(root_ / "tiny-rack.toml") + " --out {out}", 1},
+        {"a rack no layer fits", knob + " --stock-file " + quoted(root_ / "tiny-rack.toml") + " --out {out}", 1},
     };
   }
 

@@ -138,8 +138,8 @@ TEST(CliSheets, ProgressFdGetsOneLinePerPhaseInOrder) {
                         " --progress-fd 3 3>" + quoted(file));
   ASSERT_EQ(r.exit_code, 0) << r.out;
   const auto lines = progress_lines(file);
-  const std::vector<std::string> phases{"reading the model", "choosing layers", "planning bevels", "measuring deviation",
-                                        "writing the stack", "nesting and programs", "writing sheets", "done"};
+  const std::vector<std::string> phases{"reading the model", "choosing layers", "planning bevels", "nesting and programs",
+                                        "measuring deviation", "writing the stack", "writing sheets", "done"};
   ASSERT_EQ(lines.size(), phases.size()) << slurp(file);
   for (std::size_t i = 0; i < phases.size(); ++i) {
     EXPECT_EQ(lines[i]["phase"], phases[i]);

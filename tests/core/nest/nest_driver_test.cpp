@@ -115,10 +115,33 @@ TEST_P(NestDriver, NotEnoughSheets) {
   stock.sheets.push_back({10.0, 190, 190, 2, ""});
   auto nest = nest_parts(parts, stock, params_for(GetParam()));
   ASSERT_FALSE(nest);
-  EXPECT_EQ(nest.error().code, ErrorCode::invalid_argument);
+  EXPECT_EQ(nest.error().code, ErrorCode::stock_exhausted);
   const std::string& m = nest.error().message;
   EXPECT_NE(m.find("not enough 10 mm sheets: 3 in stock"), std::string::npos) << m;
   EXPECT_NE(m.find("at least 5 sheets needed (2 more of 190 x 190 mm)"), std::string::npos) << m;
+}
+
+// The planner lays the stack out again with what the rack held (issue 17, item 5): each
+// thickness that ran out says how many of its layers were placed whole.
+TEST_P(NestDriver, ShortagesCountTheLayersPlacedWhole) {
+  std::vector<Part> parts;
+  for (int layer = 0; layer < 5; ++layer) {
+    parts.push_back(make_part(rect(150, 150), 10.0, layer, 1));
+    parts.back().layer_slot = layer;
+  }
+  parts.push_back(make_part(rect(20, 20), 1.0, 9, 1));  // a thickness with enough sheets
+  parts.back().layer_slot = 9;
+  Stock stock;
+  stock.sheets.push_back({10.0, 200, 200, 3, ""});
+  stock.sheets.push_back({1.0, 100, 100, 1, ""});
+  std::vector<SheetShortage> shortages;
+  auto nest = nest_parts(parts, stock, params_for(GetParam()), &shortages);
+  ASSERT_FALSE(nest);
+  EXPECT_EQ(nest.error().code, ErrorCode::stock_exhausted);
+  ASSERT_EQ(shortages.size(), 1u);
+  EXPECT_EQ(shortages[0].thickness_mm, 10.0);
+  EXPECT_EQ(shortages[0].layers, 5);
+  EXPECT_EQ(shortages[0].layers_placed, 3) << "one 150 mm part per 200 mm sheet, three sheets";
 }
 
 TEST_P(NestDriver, BadParameters) {

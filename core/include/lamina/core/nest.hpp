@@ -61,11 +61,23 @@ struct Nest {
   std::vector<NestedSheet> sheets;
 };
 
+// A thickness the rack has too few sheets of (issue 17, item 5): how many of its layers found a
+// place for every one of their parts on the sheets there are. The planner lowers that
+// thickness's count in the layering to what was placed and lays the stack out again.
+struct SheetShortage {
+  double thickness_mm = 0.0;
+  int layers = 0;         // layers (Part::layer_slot) of this thickness among the parts
+  int layers_placed = 0;  // of them, those whose parts were all placed
+};
+
 // Place every part on a sheet of its thickness. Errors (ErrorCode::invalid_argument) name the
 // thickness and what is missing: no sheet of that thickness, a sheet without a known size, a part
 // larger than every sheet of its thickness, or not enough sheets (count) for all its parts.
-// A stock count of 0 means the count is not known: as many sheets as needed.
-std::expected<Nest, Error> nest_parts(std::span<const Part> parts, const Stock& stock, const NestParams& params);
+// A stock count of 0 means the count is not known: as many sheets as needed. Too few sheets is
+// ErrorCode::stock_exhausted; then, when `shortages` is given, it receives one entry for every
+// thickness that ran out (not only the one the error names).
+std::expected<Nest, Error> nest_parts(std::span<const Part> parts, const Stock& stock, const NestParams& params,
+                                      std::vector<SheetShortage>* shortages = nullptr);
 
 // A part's footprint placed on its sheet.
 Polygon2 placed_footprint(const Part& part, const Placement& placement);

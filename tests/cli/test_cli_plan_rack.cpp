@@ -1,0 +1,112 @@
+// `lamina plan` against the rack (issue 17, item 5): `lamina plan bowl.stl --stock-file
+// examples/remnants.toml` failed at nesting with "not enough 5 mm sheets: 2 in stock". A plan
+// fits the rack — no more layers of a thickness than its sheets hold, no layer on a sheet it does
+// not fit — or one error, before anything is written, says which thickness runs out.
+#include "cli_runner.hpp"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <numbers>
+#include <sstream>
+#include <string>
+
+namespace {
+
+using namespace lamina_cli_test;
+using nlohmann::json;
+
+struct TempDir {
+  fs::path path;
+  explicit TempDir(const std::string& name) : path(temp_file(name)) {
+    fs::remove_all(path);
+    fs::create_directories(path);
+  }
+  ~TempDir() { fs::remove_all(path); }
+};
+
+// A truncated cone, r 40 at z 0 to r 20 at z 20 (45°: bevels follow it exactly, so thick sheets
+// are the layering's first choice), as ASCII STL.
+std::string cone_stl() {
+  constexpr int n = 48;
+  auto ring = [](double r, double z, int i) {
+    const double a = 2 * std::numbers::pi * i / n;
+    return std::array<double, 3>{r * std::cos(a), r * std::sin(a), z};
+  };
+  std::ostringstream s;
+  auto facet = [&](std::array<double, 3> a, std::array<double, 3> b, std::array<double, 3> c) {
+    s << "facet normal 0 0 0\nouter loop\n";
+    for (const auto& v : {a, b, c}) s << "vertex " << v[0] << ' ' << v[1] << ' ' << v[2] << '\n';
+    s << "endloop\nendfacet\n";
+  };
+  s.precision(12);
+  s << "solid cone\n";
+  for (int i = 0; i < n; ++i) {
+    const auto b0 = ring(40, 0, i), b1 = ring(40, 0, i + 1), t0 = ring(20, 20, i), t1 = ring(20, 20, i + 1);
+    facet(b0, b1, t1);
+    facet(b0, t1, t0);
+    facet({0, 0, 0}, b1, b0);
+    facet({0, 0, 20}, t0, t1);
+  }
+  s << "endsolid cone\n";
+  return s.str();
+}
+
+std::string sheet(double t, double size, int count) {
+  return "[[sheet]]\nthickness_mm = " + std::to_string(t) + "\nwidth_mm = " + std::to_string(size) +
+         "\nlength_mm = " + std::to_string(size) + "\ncount = " + std::to_string(count) + "\n";
+}
+
+json read_report(const fs::path& dir) {
+  std::ifstream in(dir / "report.json");
+  return json::parse(in);
+}
+
+TEST(CliPlanRack, ThePlanFitsTheRacksCounts) {
+  TempDir dir("plan-rack");
+  std::ofstream(dir.path / "cone.stl") << cone_stl();
+  // One Ø80 layer (Ø81 with the kerf) per 110 mm sheet: the rack holds one 5 mm layer, the cone alone would take four.
+  std::ofstream(dir.path / "rack.toml") << sheet(1.0, 400, 2) + sheet(2.5, 400, 2) + sheet(5.0, 110, 1);
+  const std::string model = quoted(dir.path / "cone.stl");
+  const auto free = lamina("plan " + model + " --stock 1,2.5,5 --no-programs --json --out " + quoted(dir.path / "free"));
+  ASSERT_EQ(free.exit_code, 0) << free.out;
+  ASSERT_GT(read_report(dir.path / "free")["stack"]["sheets_used"].value("5", 0), 1) << "the rack must matter";
+
+  const auto r = lamina("plan " + model + " --stock-file " + quoted(dir.path / "rack.toml") + " --out " +
+                        quoted(dir.path / "out"));
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_NE(r.out.find("the rack's 5 mm sheets"), std::string::npos) << r.out;
+  const json j = read_report(dir.path / "out");
+  std::map<double, int> sheets;
+  for (const json& s : j["sheets"]) ++sheets[s["thickness_mm"].get<double>()];
+  EXPECT_LE(sheets[5.0], 1);
+  EXPECT_LE(sheets[2.5], 2);
+  EXPECT_LE(sheets[1.0], 2);
+  EXPECT_LE(j["stack"]["sheets_used"].value("5", 0), 1);
+  EXPECT_GE(j["stack"]["stack_height_mm"].get<double>(), 20.0 - 1e-6);
+}
+
+TEST(CliPlanRack, ARackThatCannotMakeTheStackSaysWhichThicknessRunsOut) {
+  TempDir dir("plan-rack-short");
+  std::ofstream(dir.path / "cone.stl") << cone_stl();
+  // 5 mm sheets only, two of them holding one layer each: 10 mm of the cone's 20.
+  std::ofstream(dir.path / "rack.toml") << sheet(5.0, 110, 2);
+  const auto r = lamina("plan " + quoted(dir.path / "cone.stl") + " --stock-file " + quoted(dir.path / "rack.toml") +
+                        " --out " + quoted(dir.path / "out"));
+  EXPECT_EQ(r.exit_code, 1) << r.out;
+  EXPECT_NE(r.out.find("stock_exhausted"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("5 mm: at most 2 layer(s)"), std::string::npos) << r.out;
+  EXPECT_FALSE(fs::exists(dir.path / "out")) << "nothing is written";
+
+  // A sheet no layer fits: said by the layering, not by a nesting failure after the stack.
+  std::ofstream(dir.path / "small.toml") << sheet(5.0, 50, 10);
+  const auto small = lamina("plan " + quoted(dir.path / "cone.stl") + " --stock-file " +
+                            quoted(dir.path / "small.toml") + " --out " + quoted(dir.path / "out"));
+  EXPECT_EQ(small.exit_code, 1) << small.out;
+  EXPECT_NE(small.out.find("no larger than 29 x 29 mm"), std::string::npos) << small.out;
+}
+
+}  // namespace
