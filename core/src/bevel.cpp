@@ -3,6 +3,7 @@
 // normal, the cut lines fitted to that profile, and passes assembled from the lines.
 #include "lamina/core/bevel.hpp"
 
+#include "bevel_distance.hpp"
 #include "bevel_gouge.hpp"
 #include "clipper_bridge.hpp"
 #include "lamina/core/section_lines.hpp"
@@ -15,6 +16,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 namespace lamina {
 
@@ -478,6 +480,11 @@ LayerPlan plan_layer(const Mesh& mesh, const LayerSpan& span, int index, const s
 
 std::expected<BevelPlan, Error> plan_bevels(const Mesh& mesh, std::span<const LayerSpan> layers,
                                             const BevelParams& params) {
+  return detail::plan_bevels_on(mesh, nullptr, layers, params);
+}
+
+std::expected<BevelPlan, Error> detail::plan_bevels_on(const Mesh& mesh, const TriangleTree* model_tree,
+                                                       std::span<const LayerSpan> layers, const BevelParams& params) {
   if (!(params.sub_slice_mm > 0.0) || !std::isfinite(params.sub_slice_mm)) {
     return std::unexpected(Error{ErrorCode::invalid_argument, fmt::format("sub-slice spacing must be > 0 mm (got {})", params.sub_slice_mm)});
   }
@@ -509,10 +516,29 @@ std::expected<BevelPlan, Error> plan_bevels(const Mesh& mesh, std::span<const La
   BevelPlan plan;
   plan.fit = params.fit;
   plan.layers.resize(layers.size());
+  std::optional<detail::TriangleTree> own_tree;
+  const detail::TriangleTree* model = model_tree;
+  if (params.measure_surface_distance && !layers.empty() && !model) {
+    own_tree.emplace(mesh.vertices, mesh.faces, params.parallel);
+    model = &*own_tree;
+  }
+  if (!params.measure_surface_distance) model = nullptr;
+  double model_z_lo = std::numeric_limits<double>::infinity(), model_z_hi = -model_z_lo;
+  if (model)
+    for (const Eigen::Vector3d& v : mesh.vertices) model_z_lo = std::min(model_z_lo, v.z()), model_z_hi = std::max(model_z_hi, v.z());
   auto one = [&](std::size_t i) {
     std::vector<const Slice*> subs;
     for (std::size_t k = first[i]; k < first[i + 1]; ++k) subs.push_back(&(*slices)[k]);
-    plan.layers[i] = plan_layer(mesh, layers[i], static_cast<int>(i), layer_z[i], subs, params);
+    LayerPlan& layer = plan.layers[i];
+    layer = plan_layer(mesh, layers[i], static_cast<int>(i), layer_z[i], subs, params);
+    layer.profile_deviation_mm = layer.max_deviation_mm;
+    if (!model) return;
+    // What the tolerance checks is the 3-D distance (issue 17, item 4): a station's plane can
+    // neither see a corner that slides along the outline nor the true (normal) distance to a
+    // sloped surface.
+    layer.surface_distance_mm = detail::layer_surface_distance(*model, model_z_lo, model_z_hi, layer, subs, params.distance_sample_mm);
+    layer.max_deviation_mm = layer.surface_distance_mm;
+    layer.within_tolerance = layer.max_deviation_mm <= params.tolerance_mm;
   };
   if (params.parallel) {
     tbb::parallel_for(std::size_t{0}, layers.size(), one);

@@ -17,7 +17,6 @@
 #include <cmath>
 
 namespace lamina::detail {
-namespace {
 
 // Samples of a horizontal region (Clipper paths, positive fill) at height z: its vertices, its
 // edges every `spacing` and the points of a `spacing` grid inside it (coarser when the region is
@@ -71,6 +70,8 @@ void sample_region(const ClipperLib::Paths& region, double z, double spacing, do
   }
 }
 
+namespace {
+
 ClipperLib::Paths section_paths(const LayerPlan& layer, double z) { return to_clipper(layer_section(layer, z)); }
 
 ClipperLib::Paths difference(const ClipperLib::Paths& a, const ClipperLib::Paths& b) {
@@ -87,56 +88,64 @@ bool usable_layer(const LayerPlan& layer) {
   return layer.thickness_mm > 0.0 && std::isfinite(layer.thickness_mm) && std::isfinite(layer.z_bottom_mm);
 }
 
+}  // namespace
+
+void wall_samples(const LayerPlan& layer, double ds, std::vector<Eigen::Vector3d>& out) {
+  std::vector<OffsetLine> lines;
+  std::vector<double> kinks;
+  const double zb = layer.z_bottom_mm, thick = layer.thickness_mm;
+  const int steps = std::max(1, static_cast<int>(std::ceil(thick / ds)));
+  std::vector<double> ts(static_cast<std::size_t>(steps) + 1);
+  for (int j = 0; j <= steps; ++j) ts[static_cast<std::size_t>(j)] = static_cast<double>(j) / steps;
+  for (const auto& outline : layer.outlines) {
+    if (!outline_usable(outline)) continue;
+    const Polygon2 base = base_ring(outline);
+    const std::size_t n = base.size();
+    std::vector<Polygon2> rings(ts.size());
+    std::vector<char> dropped(ts.size());
+    for (std::size_t j = 0; j < ts.size(); ++j) {
+      rings[j] = edge_ring(outline, ts[j]);
+      dropped[j] = reversed_share(rings[j], base) > 0.5;
+    }
+    for (std::size_t s = 0; s < n; ++s) {
+      for (std::size_t j = 0; j < ts.size(); ++j)
+        if (!dropped[j]) out.emplace_back(rings[j][s].x(), rings[j][s].y(), zb + ts[j] * thick);
+      // Where the envelope of the lines kinks: the edge's corners, farthest from a convex surface.
+      station_lines(outline, s, lines);
+      envelope_kinks(lines, kinks);
+      const CutStation& st = outline.stations[s];
+      for (const double t : kinks) {
+        const auto j = std::min(static_cast<std::size_t>(t * steps), ts.size() - 2);
+        if (dropped[j] || dropped[j + 1]) continue;
+        const Eigen::Vector2d p = st.base_mm + station_offset(outline, s, t) * st.normal;
+        out.emplace_back(p.x(), p.y(), zb + t * thick);
+      }
+      // Along the outline towards the next station.
+      const std::size_t s1 = (s + 1) % n;
+      const int pieces = static_cast<int>(std::min(1e5, std::ceil((base[s1] - base[s]).norm() / ds)));
+      for (int q = 1; q < pieces; ++q) {
+        const double f = static_cast<double>(q) / pieces;
+        for (std::size_t j = 0; j < ts.size(); ++j) {
+          if (dropped[j]) continue;
+          const Eigen::Vector2d p = rings[j][s] + f * (rings[j][s1] - rings[j][s]);
+          out.emplace_back(p.x(), p.y(), zb + ts[j] * thick);
+        }
+      }
+    }
+  }
+}
+
+namespace {
+
 // Samples of the stack's surface: walls and exposed faces.
 std::vector<Eigen::Vector3d> stack_samples(const BevelPlan& plan, double ds) {
   std::vector<Eigen::Vector3d> out;
-  std::vector<OffsetLine> lines;
-  std::vector<double> kinks;
   constexpr double kRegionBudget = 250000.0;
   for (std::size_t li = 0; li < plan.layers.size(); ++li) {
     const LayerPlan& layer = plan.layers[li];
     if (!usable_layer(layer)) continue;
-    const double zb = layer.z_bottom_mm, thick = layer.thickness_mm;
-    const int steps = std::max(1, static_cast<int>(std::ceil(thick / ds)));
-    std::vector<double> ts(static_cast<std::size_t>(steps) + 1);
-    for (int j = 0; j <= steps; ++j) ts[static_cast<std::size_t>(j)] = static_cast<double>(j) / steps;
-
-    for (const auto& outline : layer.outlines) {
-      if (!outline_usable(outline)) continue;
-      const Polygon2 base = base_ring(outline);
-      const std::size_t n = base.size();
-      std::vector<Polygon2> rings(ts.size());
-      std::vector<char> dropped(ts.size());
-      for (std::size_t j = 0; j < ts.size(); ++j) {
-        rings[j] = edge_ring(outline, ts[j]);
-        dropped[j] = reversed_share(rings[j], base) > 0.5;
-      }
-      for (std::size_t s = 0; s < n; ++s) {
-        for (std::size_t j = 0; j < ts.size(); ++j)
-          if (!dropped[j]) out.emplace_back(rings[j][s].x(), rings[j][s].y(), zb + ts[j] * thick);
-        // Where the envelope of the lines kinks: the edge's corners, farthest from a convex surface.
-        station_lines(outline, s, lines);
-        envelope_kinks(lines, kinks);
-        const CutStation& st = outline.stations[s];
-        for (const double t : kinks) {
-          const auto j = std::min(static_cast<std::size_t>(t * steps), ts.size() - 2);
-          if (dropped[j] || dropped[j + 1]) continue;
-          const Eigen::Vector2d p = st.base_mm + station_offset(outline, s, t) * st.normal;
-          out.emplace_back(p.x(), p.y(), zb + t * thick);
-        }
-        // Along the outline towards the next station.
-        const std::size_t s1 = (s + 1) % n;
-        const int pieces = static_cast<int>(std::min(1e5, std::ceil((base[s1] - base[s]).norm() / ds)));
-        for (int q = 1; q < pieces; ++q) {
-          const double f = static_cast<double>(q) / pieces;
-          for (std::size_t j = 0; j < ts.size(); ++j) {
-            if (dropped[j]) continue;
-            const Eigen::Vector2d p = rings[j][s] + f * (rings[j][s1] - rings[j][s]);
-            out.emplace_back(p.x(), p.y(), zb + ts[j] * thick);
-          }
-        }
-      }
-    }
+    const double zb = layer.z_bottom_mm;
+    wall_samples(layer, ds, out);
 
     // Exposed faces: the top not covered by the next layer's bottom, the bottom not covered by
     // the previous layer's top (a bonded stack's inner faces are no surface of the part).
@@ -151,6 +160,8 @@ std::vector<Eigen::Vector3d> stack_samples(const BevelPlan& plan, double ds) {
   }
   return out;
 }
+
+}  // namespace
 
 // The sample farthest from the tree (the first of equals, in sample order).
 FarthestPoint max_distance(const TriangleTree& tree, const std::vector<Eigen::Vector3d>& samples, bool parallel) {
@@ -189,8 +200,6 @@ FarthestPoint max_distance(const TriangleTree& tree, const std::vector<Eigen::Ve
     if (f.distance > best.distance) best = f;
   return best;
 }
-
-}  // namespace
 
 FarthestPoint max_surface_distance(const Mesh& mesh, const BevelPlan& plan, const DeviationParams& params) {
   std::vector<Eigen::Vector3d> samples = stack_samples(plan, params.distance_sample_mm);

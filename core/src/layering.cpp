@@ -158,8 +158,11 @@ std::expected<Layering, Error> choose_layers(const Mesh& mesh, const LayeringPar
   layering_detail::Estimator& est = **created;
   const std::vector<double>& t = est.thicknesses();
 
-  const auto choice = params.method == LayeringMethod::greedy ? layering_detail::layer_greedy(est, params)
-                                                               : layering_detail::layer_optimal(est, params);
+  auto verified = params.method == LayeringMethod::greedy
+                      ? std::expected<layering_detail::LayerChoice, Error>(layering_detail::layer_greedy(est, params))
+                      : layering_detail::layer_verified(est, mesh, params);
+  if (!verified) return std::unexpected(verified.error());
+  const layering_detail::LayerChoice& choice = *verified;
   if (choice.state_limit || choice.layers.empty()) return std::unexpected(rack_error(est, params, choice));
   const auto& chosen = choice.layers;
   Layering out;

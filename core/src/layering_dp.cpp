@@ -125,8 +125,14 @@ LayerChoice layer_optimal(Estimator& est, const LayeringParams& params) {
     for (std::size_t i = 0; i < t.size(); ++i) {
       if (!usable(i)) continue;
       // Only passing layers, unless none passes: then the thinnest usable, its deviation reported.
-      if (any ? r.dev[i] > tol : static_cast<int>(i) != thinnest) continue;
-      double d = any ? r.dev[i] : est.estimate(r.cands[i].first, static_cast<int>(i));
+      // The thinnest sheet that ends the stack is an edge even when it fails: where the stack ends
+      // ranks first (best_final), and the layer that ends it nearest may be out of tolerance (a
+      // cup's rim inside its last 1 mm sheet). Not a thicker one: one thick failing layer would
+      // outrank several thin ones at a pole flatter than the tilt limit.
+      const bool passes = r.dev[i] <= tol;
+      const bool thinnest_end = r.ends[i].final && static_cast<int>(i) == thinnest;
+      if (any ? !passes && !thinnest_end : static_cast<int>(i) != thinnest) continue;
+      double d = any && passes ? r.dev[i] : est.estimate(r.cands[i].first, static_cast<int>(i));
       if (r.ends[i].final) d = std::max(d, r.ends[i].off_top_mm);
       const bool ok = d <= tol;
       const double top = cur.z + t[i];

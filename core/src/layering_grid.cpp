@@ -315,6 +315,7 @@ void Estimator::estimate(std::span<const std::pair<GridSpan, int>> layers, std::
   auto answered = [&](const Memo& m) { return m.exact || m.value > fail_above; };
   std::vector<std::size_t> todo;
   for (std::size_t i = 0; i < layers.size(); ++i) {
+    if (measured_.count(key_of(i))) continue;
     if (auto it = memo_.find(key_of(i)); it != memo_.end() && answered(it->second)) continue;
     if (std::find_if(todo.begin(), todo.end(), [&](std::size_t t) { return layers[t] == layers[i]; }) == todo.end())
       todo.push_back(i);
@@ -354,7 +355,14 @@ void Estimator::estimate(std::span<const std::pair<GridSpan, int>> layers, std::
     for (std::size_t i = 0; i < tasks.size(); ++i) worst[tasks[i].slot] = std::max(worst[tasks[i].slot], dev[i]);
     for (std::size_t t = 0; t < todo.size(); ++t) memo_[key_of(todo[t])] = Memo{worst[t], !(worst[t] > fail_above)};
   }
-  for (std::size_t i = 0; i < layers.size(); ++i) out[i] = memo_.at(key_of(i)).value;
+  for (std::size_t i = 0; i < layers.size(); ++i) {
+    const auto m = measured_.find(key_of(i));
+    out[i] = m != measured_.end() ? m->second : memo_.at(key_of(i)).value;
+  }
+}
+
+bool Estimator::set_measured(GridSpan span, int thickness_index, double deviation_mm) {
+  return measured_.insert_or_assign(std::make_tuple(span.ka, span.kb, thickness_index), deviation_mm).second;
 }
 
 double Estimator::estimate(GridSpan span, int thickness_index) {
@@ -399,7 +407,7 @@ Estimator::GreedyCheck Estimator::greedy_check(GridSpan span, int thickness_inde
 void Estimator::release_below(int k) {
   const int limit = std::min(2 * k, slice_count());
   for (; released_ < limit; ++released_) cache_[static_cast<std::size_t>(released_)] = SliceCache{};
-  memo_.erase(memo_.begin(), memo_.lower_bound(std::make_tuple(k, std::numeric_limits<int>::min(), 0)));
+  // The memo is kept (a few numbers per position): a second pass (layer_verified) reuses it.
 }
 
 }  // namespace lamina::layering_detail

@@ -108,8 +108,18 @@ class Estimator {
   };
   GreedyCheck greedy_check(GridSpan span, int thickness_index);
 
-  // Positions only grow: caches of slices below grid line k are no longer needed.
+  // Positions only grow: caches of slices below grid line k are no longer needed. A new pass
+  // of a method over the grid starts again from the bottom (restart; released caches are
+  // rebuilt on demand, estimates stay memoized).
   void release_below(int k);
+  void restart() { released_ = 0; }
+
+  // What the bevel planner measured for a layer (issue 17, item 4): from then on the layer's
+  // estimate is that measure (layering_verify.cpp). Returns whether it was new.
+  bool set_measured(GridSpan span, int thickness_index, double deviation_mm);
+  bool is_measured(GridSpan span, int thickness_index) const {
+    return measured_.count(std::make_tuple(span.ka, span.kb, thickness_index)) > 0;
+  }
 
   // The supply (layering_supply.cpp): how many layers of a thickness the rack holds (-1: no
   // limit), and whether every outer loop of a layer's sections fits one of its rooms.
@@ -164,6 +174,7 @@ class Estimator {
     bool exact = true;
   };
   std::map<std::tuple<int, int, int>, Memo> memo_;
+  std::map<std::tuple<int, int, int>, double> measured_;  // (ka, kb, thickness) → planner's measure
   std::vector<std::string> warnings_;
 };
 
@@ -210,5 +221,8 @@ class SupplyCounter {
 
 LayerChoice layer_optimal(Estimator& est, const LayeringParams& params);
 LayerChoice layer_greedy(Estimator& est, const LayeringParams& params);
+// The optimal layering, its chosen layers planned and measured by the bevel planner until the
+// choice rests on measures only (layering_verify.cpp). Errors are the planner's.
+std::expected<LayerChoice, Error> layer_verified(Estimator& est, const Mesh& mesh, const LayeringParams& params);
 
 }  // namespace lamina::layering_detail

@@ -7,6 +7,8 @@
 #include "lamina/core/mesh.hpp"
 #include "lamina/core/polygon.hpp"
 
+#include <polyclipping/clipper.hpp>
+
 #include <Eigen/Core>
 
 #include <array>
@@ -78,5 +80,19 @@ struct FarthestPoint {
   Eigen::Vector3d at = Eigen::Vector3d::Zero();
 };
 FarthestPoint max_surface_distance(const Mesh& mesh, const BevelPlan& plan, const DeviationParams& params);
+
+// Points on a layer's side walls (the edge its cuts leave): rows no more than ds apart from face
+// to face, where the envelope of a station's lines kinks, and along the outline between stations.
+void wall_samples(const LayerPlan& layer, double ds, std::vector<Eigen::Vector3d>& out);
+
+// Samples of a horizontal region (Clipper paths, positive fill) at height z: its vertices, its
+// edges every `spacing` and the points of a `spacing` grid inside it (coarser when the grid would
+// exceed `budget` points).
+void sample_region(const ClipperLib::Paths& region, double z, double spacing, double budget,
+                   std::vector<Eigen::Vector3d>& out);
+
+class TriangleTree;
+// The sample farthest from the tree's triangles (the first of equals, in sample order).
+FarthestPoint max_distance(const TriangleTree& tree, const std::vector<Eigen::Vector3d>& samples, bool parallel);
 
 }  // namespace lamina::detail

@@ -206,7 +206,9 @@ int run_plan(const PlanOptions& o, const CamOptions& cam_options) {
   for (const BevelStrategy s : {BevelStrategy::vertical, BevelStrategy::sloped, BevelStrategy::curved}) {
     std::optional<BevelPlan> other;
     if (s != settings->strategy) {
-      auto p = plan_bevels(mesh, r.layering.layers, bevel_params(*settings, s));
+      BevelParams geometry_only = bevel_params(*settings, s);
+      geometry_only.measure_surface_distance = false;  // its stack is measured as a whole below
+      auto p = plan_bevels(mesh, r.layering.layers, geometry_only);
       if (!p) return report_error(p.error());
       other = std::move(*p);
     }

@@ -50,6 +50,7 @@ Json layer_json(const LayerPlan& l, const LayerSpan* span) {
           {"sub_slices", l.sub_slice_z_mm.size()},
           {"passes", l.passes},
           {"max_deviation_mm", l.max_deviation_mm},
+          {"profile_deviation_mm", l.profile_deviation_mm},
           {"within_tolerance", l.within_tolerance},
           {"gouge_shift_mm", l.gouge_shift_mm},
           {"gouge_left_mm", l.gouge_left_mm},

@@ -6,11 +6,13 @@
 // estimated deviation is the tolerance it achieves; the optimal layering gets exactly that.
 #include "layering_checks.hpp"
 
+#include <lamina/core/bevel.hpp>
 #include <lamina/core/layering.hpp>
 #include <lamina/core/mesh_io.hpp>
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <numbers>
 
@@ -52,6 +54,37 @@ TEST_P(LayeringSharedModels, OptimalNeverUsesMoreLayersThanGreedyAtTheSameTolera
   ::testing::Test::RecordProperty("optimal_layers", static_cast<int>(optimal->layers.size()));
   std::printf("%s: greedy %zu layers, optimal %zu layers at tolerance %.3f mm\n", GetParam(), greedy->layers.size(),
               optimal->layers.size(), po.tolerance_mm);
+}
+
+// Issue 17, item 4: per layer, the layering's estimate and the plan's measure agree within 20 %
+// (the last layer's estimate also holds how far the stack ends from the model's top).
+TEST_P(LayeringSharedModels, EveryLayersEstimateIsThePlansMeasure) {
+  const std::filesystem::path path = std::filesystem::path(LAMINA_SHARED_MODELS) / GetParam();
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << "shared model not present: " << path;
+  auto soup = read_mesh_file(path);
+  ASSERT_TRUE(soup.has_value()) << soup.error().message;
+  auto mesh = build_mesh(*soup, MeshParams{});
+  ASSERT_TRUE(mesh.has_value()) << mesh.error().message;
+  auto p = stock_params(LayeringMethod::optimal);
+  p.tolerance_mm = 0.2;
+  auto layering = choose_layers(*mesh, p);
+  ASSERT_TRUE(layering.has_value()) << layering.error().message;
+  BevelParams b;
+  b.fit = p.fit;
+  b.sub_slice_mm = p.sub_slice_mm;
+  b.tolerance_mm = p.tolerance_mm;
+  auto plan = plan_bevels(*mesh, layering->layers, b);
+  ASSERT_TRUE(plan.has_value()) << plan.error().message;
+  const double top = layering->model_height_mm;
+  for (std::size_t i = 0; i < plan->layers.size(); ++i) {
+    const double measure = plan->layers[i].max_deviation_mm;
+    double estimate = layering->layers[i].estimated_deviation_mm;
+    if (i + 1 == plan->layers.size()) {
+      const double off = std::abs(layering->stack_height_mm - top);
+      if (estimate <= off + 1e-9 && measure <= off) continue;  // it ends the stack: that is its estimate
+    }
+    EXPECT_NEAR(estimate, measure, 0.2 * std::max(measure, 0.01)) << GetParam() << " layer " << i;
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Issue, LayeringSharedModels, ::testing::Values("vase.stl", "flange.stl", "dome.stl"),

@@ -45,7 +45,9 @@ TEST(LayeringSloped, DoubleConeWithinTheTiltLimitTakesTheThickestSheets) {
   ASSERT_EQ(r->layers.size(), 4u);
   for (const auto& l : r->layers) {
     EXPECT_EQ(l.thickness_mm, 10.0);
-    EXPECT_LT(l.estimated_deviation_mm, 1e-3) << "z " << l.z_bottom_mm;
+    // The plan's 3-D measure (issue 17, item 4) reads sub-slices 1 µm inside the faces: exact
+    // ruled cuts read as about that much.
+    EXPECT_LT(l.estimated_deviation_mm, 2e-3) << "z " << l.z_bottom_mm;
   }
 
   auto g = choose_layers(mesh, stock_params(LayeringMethod::greedy));

@@ -194,7 +194,8 @@ TEST(LayeringVertical, TubeWithBoreIsStillExact) {
   expect_well_formed(*r, p);
   EXPECT_EQ(r->layers.size(), 2u);  // 15 = 10 + 5
   EXPECT_DOUBLE_EQ(r->stack_height_mm, 15.0);
-  for (const auto& l : r->layers) EXPECT_LT(l.estimated_deviation_mm, 1e-6);
+  // The plan's 3-D measure (issue 17, item 4) samples a float mesh: exact reads as ~2e-5 mm.
+  for (const auto& l : r->layers) EXPECT_LT(l.estimated_deviation_mm, 1e-4);
 }
 
 }  // namespace

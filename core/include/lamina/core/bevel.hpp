@@ -65,7 +65,12 @@ struct LayerPlan {
   std::vector<double> sub_slice_z_mm;   // the thin slices the layer's profiles were read from
   std::vector<LayerOutline> outlines;   // outers and their holes (parent links)
   int passes = 0;                       // largest pass count of its outlines
-  double max_deviation_mm = 0.0;        // largest station deviation (profile plane), mm
+  // What the tolerance checks (issue 17, item 4): the largest 3-D distance between the edge the
+  // cuts leave and the model's surface in the layer's height (surface_distance_mm) when the
+  // plan measured it (BevelParams::measure_surface_distance), else the profile-plane deviation.
+  double max_deviation_mm = 0.0;
+  double profile_deviation_mm = 0.0;    // largest station deviation, in each station's profile plane
+  double surface_distance_mm = -1.0;    // sampled two-way 3-D distance (-1: not measured)
   bool within_tolerance = true;
   // Outside cuts moved off material their chords took between stations (issue 17, item 1: a
   // sharp corner on a sloped face): the largest move of a station, and the deepest sub-slice
@@ -86,6 +91,10 @@ struct BevelParams {
   // Holes of a layer outline narrower than this (mean width 2·area/perimeter) stay closed: a
   // jet cannot cut them, and they are mostly slivers where sub-slices nearly coincide.
   double min_hole_width_mm = 0.1;
+  // Measure each layer's 3-D distance to the model (LayerPlan::surface_distance_mm), sampled
+  // distance_sample_mm apart; off for plans only their geometry is wanted of.
+  bool measure_surface_distance = true;
+  double distance_sample_mm = 0.5;
   bool parallel = true;             // layers on several threads (TBB); results do not depend on it
 };
 
