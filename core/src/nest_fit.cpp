@@ -23,6 +23,12 @@ __int128 cross(const IntPoint& o, const IntPoint& a, const IntPoint& b) {
 
 constexpr std::size_t kProxyCorners = 64;
 
+// How far a simplified concave proxy may stand off the ring it holds (between half this and 1.5
+// times this): 50 µm, under the 64-gon's 60 µm on a Ø100 disc. The no-fit regions' cost grows
+// with the product of both rings' corners, and a footprint's round-joined kerf offset has corners
+// every few µm at its convex bends.
+constexpr double kSimplifyMm = 0.05;
+
 }  // namespace
 
 Path convex_hull(Path pts) {
@@ -74,9 +80,77 @@ bool is_convex(const Path& ring) {
   return true;
 }
 
+namespace {
+
+// Douglas–Peucker on a closed ring, keeping corner 0 and the corner farthest from it: every
+// dropped corner is within `tol` of the chord that replaces it.
+Path douglas_peucker(const Path& ring, double tol) {
+  const std::size_t n = ring.size();
+  auto dist2 = [&](std::size_t i, std::size_t j) {
+    const double dx = static_cast<double>(ring[i % n].X - ring[j % n].X);
+    const double dy = static_cast<double>(ring[i % n].Y - ring[j % n].Y);
+    return dx * dx + dy * dy;
+  };
+  std::size_t far = 0;
+  for (std::size_t i = 1; i < n; ++i)
+    if (dist2(i, 0) > dist2(far, 0)) far = i;
+  std::vector<bool> keep(n, false);
+  keep[0] = keep[far] = true;
+  std::vector<std::pair<std::size_t, std::size_t>> spans{{0, far}, {far, n}};  // corner n is corner 0
+  while (!spans.empty()) {
+    const auto [a, b] = spans.back();
+    spans.pop_back();
+    const IntPoint& pa = ring[a % n];
+    const double ex = static_cast<double>(ring[b % n].X - pa.X), ey = static_cast<double>(ring[b % n].Y - pa.Y);
+    const double len = std::hypot(ex, ey);
+    double worst = 0.0;
+    std::size_t at = a;
+    for (std::size_t i = a + 1; i < b; ++i) {
+      const double px = static_cast<double>(ring[i].X - pa.X), py = static_cast<double>(ring[i].Y - pa.Y);
+      // Distance to the segment (not the line), so a chord never strays past its span.
+      const double u = len > 0.0 ? std::clamp((px * ex + py * ey) / (len * len), 0.0, 1.0) : 0.0;
+      const double d = std::hypot(px - u * ex, py - u * ey);
+      if (d > worst) {
+        worst = d;
+        at = i;
+      }
+    }
+    if (worst <= tol) continue;
+    keep[at] = true;
+    spans.emplace_back(a, at);
+    spans.emplace_back(at, b);
+  }
+  Path out;
+  for (std::size_t i = 0; i < n; ++i)
+    if (keep[i]) out.push_back(ring[i]);
+  return out;
+}
+
+// A simple ring (Clipper finds no crossing to split) with the same area as `ring`.
+bool is_simple(const Path& ring) {
+  Paths parts;
+  ClipperLib::SimplifyPolygon(ring, parts, ClipperLib::pftNonZero);
+  return parts.size() == 1 && std::abs(ClipperLib::Area(parts.front()) - ClipperLib::Area(ring)) <= 1.0;
+}
+
+}  // namespace
+
+Path simplified_outside(const Path& ring) {
+  // Grown by kSimplifyMm (mitred: every point of the grown ring at least that far out), then
+  // chords within kSimplifyMm / 2 of it: the chords stay ≥ kSimplifyMm / 2 outside the ring.
+  const Paths grown = offset_mitre({ring}, kSimplifyMm);
+  if (grown.size() != 1 || !ClipperLib::Orientation(grown.front())) return ring;
+  Path out = douglas_peucker(grown.front(), 0.5 * kSimplifyMm * kClipperUnitsPerMm);
+  if (out.size() >= ring.size() || out.size() < 3 || !ClipperLib::Orientation(out) || !is_simple(out)) return ring;
+  // Belt and braces: the simplified ring must hold the ring (else keep the ring itself).
+  if (area_mm2(boolean(ClipperLib::ctDifference, {ring}, {out})) != 0.0) return ring;
+  return out;
+}
+
 Path outer_proxy(const Path& ring) {
   Path hull = convex_hull(ring);
-  if (hull.size() < 3 || ClipperLib::Area(hull) > 1.02 * std::abs(ClipperLib::Area(ring))) return ring;
+  if (hull.size() < 3 || ClipperLib::Area(hull) > 1.02 * std::abs(ClipperLib::Area(ring)))
+    return simplified_outside(ring);
   return hull.size() > kProxyCorners ? circumscribed(hull, static_cast<int>(kProxyCorners)) : hull;
 }
 
@@ -175,6 +249,67 @@ Paths minkowski_sum(const Path& a, const Path& b) {
   return boolean(ClipperLib::ctUnion, quads, {translated(a, b.front()), translated(b, a.front())});
 }
 
+namespace {
+
+struct Window {
+  ClipperLib::cInt x0 = INT64_MAX, y0 = INT64_MAX, x1 = INT64_MIN, y1 = INT64_MIN;
+  void add(const IntPoint& p) {
+    x0 = std::min(x0, p.X);
+    y0 = std::min(y0, p.Y);
+    x1 = std::max(x1, p.X);
+    y1 = std::max(y1, p.Y);
+  }
+  bool meets(const Window& o) const { return x0 <= o.x1 && o.x0 <= x1 && y0 <= o.y1 && o.y0 <= y1; }
+};
+
+Window window_of(const Path& ring) {
+  Window w;
+  for (const IntPoint& p : ring) w.add(p);
+  return w;
+}
+
+// The pieces of G ⊕ (−C) (as minkowski_sum) that may meet `window`: the hull when both are
+// convex, else the edge-pair parallelograms whose bounds meet it, with G − c0 and −C + g0.
+void no_fit_pieces(const Path& g, const Path& neg, const Window& window, Paths& out) {
+  if (is_convex(g) && is_convex(neg)) {
+    for (Path& p : minkowski_sum(g, neg)) out.push_back(std::move(p));
+    return;
+  }
+  for (Path ring : {translated(g, neg.front()), translated(neg, g.front())})
+    if (window_of(ring).meets(window)) out.push_back(std::move(ring));
+  for (std::size_t i = 0; i < g.size(); ++i) {
+    const IntPoint& a = g[i];
+    const IntPoint& b = g[(i + 1) % g.size()];
+    for (std::size_t j = 0; j < neg.size(); ++j) {
+      const IntPoint& u = neg[j];
+      const IntPoint& v = neg[(j + 1) % neg.size()];
+      Path quad{{a.X + u.X, a.Y + u.Y}, {b.X + u.X, b.Y + u.Y}, {b.X + v.X, b.Y + v.Y}, {a.X + v.X, a.Y + v.Y}};
+      if (!window_of(quad).meets(window)) continue;
+      const double area = ClipperLib::Area(quad);
+      if (area == 0.0) continue;  // parallel edges: a segment, covered by its neighbours' sides
+      if (area < 0.0) ClipperLib::ReversePath(quad);
+      out.push_back(std::move(quad));
+    }
+  }
+}
+
+}  // namespace
+
+Paths without_no_fit(const Paths& fit, const std::vector<Path>& children, const Path& c) {
+  if (fit.empty() || children.empty()) return fit;
+  Window window;
+  for (const Path& p : fit)
+    for (const IntPoint& q : p) window.add(q);
+  // Only what meets the fit region's bounds can take anything from it: for a candidate that
+  // nearly fills its hole that is a small share of the |G| × |C| parallelograms, and one
+  // difference with all of them (non-zero rule) replaces a union per child.
+  const Path neg = negated(c);
+  Paths blocked;
+  for (const Path& g : children) no_fit_pieces(g, neg, window, blocked);
+  if (blocked.empty()) return fit;
+  return boolean(ClipperLib::ctDifference, fit, blocked);
+}
+
 Paths inner_fit_general(const Paths& room, const Path& c) {
   if (c.empty()) return {};
   const Path neg = negated(c);
@@ -194,7 +329,10 @@ Paths inner_fit_general(const Paths& room, const Path& c) {
 }
 
 Paths inner_fit(const Paths& room, const Path& c) {
-  if (room.size() != 1 || !is_convex(room.front()) || !is_convex(c)) return inner_fit_general(room, c);
+  if (room.size() != 1 || !is_convex(room.front())) return inner_fit_general(room, c);
+  // A convex room holds C exactly when it holds C's hull: the shortcut below is exact for a
+  // concave C too, and the general formula's |room| × |C| parallelograms are not needed.
+  if (!is_convex(c)) return inner_fit(room, convex_hull(c));
   // C + t lies left of room edge (p, p + e) iff its corner c* of least e × c does: the edge moved by −c*.
   const Path& r = room.front();
   using V = Eigen::Vector2d;

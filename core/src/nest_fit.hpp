@@ -19,8 +19,12 @@ bool is_convex(const ClipperLib::Path& ring);
 
 // A ring containing `ring`, with few corners when that costs little room: its convex hull when
 // the hull adds at most 2 % of the area (circumscribed by 64 supporting lines beyond 64 corners,
-// ≤ 0.12 % of the radius off a round part), else the ring itself.
+// ≤ 0.12 % of the radius off a round part), else simplified_outside(ring).
 ClipperLib::Path outer_proxy(const ClipperLib::Path& ring);
+
+// A simple ring containing `ring`, 25-75 µm outside it, with fewer corners (Douglas–Peucker on
+// the ring grown by 50 µm); the ring itself when that fails or saves nothing.
+ClipperLib::Path simplified_outside(const ClipperLib::Path& ring);
 
 // A ring contained in `ring`: for a convex ring of more than 64 corners, 64 of its corners evenly
 // picked (their hull lies in any convex set holding them); for a nearly convex one (pockets no
@@ -35,8 +39,14 @@ ClipperLib::Path inner_proxy(const ClipperLib::Path& ring);
 // a0 ∈ x − B or x − b0 ∈ A.
 ClipperLib::Paths minkowski_sum(const ClipperLib::Path& a, const ClipperLib::Path& b);
 
-// {t : C + t ⊂ room} for a ring C. Convex room ring and convex C: the room's edges, each moved
-// inwards by C's extreme corner (half-plane intersection). Otherwise, for any region:
+// `fit` less the no-fit region G ⊕ (−C) of every ring G of `children`: the same region as
+// subtracting each minkowski_sum(G, negated(C)), but only the pieces that meet fit's bounds are
+// built, and they are not united first.
+ClipperLib::Paths without_no_fit(const ClipperLib::Paths& fit, const std::vector<ClipperLib::Path>& children,
+                                 const ClipperLib::Path& c);
+
+// {t : C + t ⊂ room} for a ring C. Convex room ring: the room's edges, each moved inwards by the
+// extreme corner of C's hull (half-plane intersection; a convex room holds C iff it holds the hull). Otherwise, for any region:
 // (room − c0) minus, for every ring r of the room, ∂r ⊕ ∂(−C) and r[0] − C. Why: C + t stays in
 // the room iff one point (c0 + t) is in it and C + t meets no boundary ring; C + t meets ring r
 // iff its boundary crosses r (the parallelograms) or r lies wholly inside C + t (then r[0] does).

@@ -137,14 +137,7 @@ class HoleFiller {
         if (c.box.dx() > room_box.dx() || c.box.dy() > room_box.dy()) continue;
         Paths fit = inner_fit(room0, c.proxy);
         if (fit.empty()) continue;
-        if (!grown.empty()) {
-          const Path neg = negated(c.proxy);
-          Paths blocked;
-          for (const Path& g : grown)
-            for (Path& q : minkowski_sum(g, neg)) blocked.push_back(std::move(q));
-          fit = boolean(ClipperLib::ctDifference, fit, blocked);
-        }
-        fit = offset_mitre(fit, -kNeedleMm);
+        fit = offset_mitre(without_no_fit(fit, grown, c.proxy), -kNeedleMm);
         // Bottom-left: the lowest corner of the feasible region, then the leftmost.
         for (const Path& p : fit)
           for (const IntPoint& q : p)

@@ -146,6 +146,64 @@ TEST(NestFit, InnerProxyOfANearlyConvexHoleIsInsideItAndSmall) {
   EXPECT_EQ(detail::inner_proxy(deep), deep);  // a real pocket: the ring itself
 }
 
+// A U of many corners, as a layer of a vase cut along its axis comes out: two round-ended walls
+// joined by a curved floor (concave, far from its hull).
+Path vase_u(int n, double scale = 1.0) {
+  Polygon2 u;
+  for (int k = 0; k <= n; ++k) {  // outer arc, then the inner arc back
+    const double a = std::numbers::pi * (1.0 + static_cast<double>(k) / n);
+    u.emplace_back(60.0 * scale * std::cos(a), 60.0 * scale * std::sin(a));
+  }
+  for (int k = n; k >= 0; --k) {
+    const double a = std::numbers::pi * (1.0 + static_cast<double>(k) / n);
+    u.emplace_back(45.0 * scale * std::cos(a), 45.0 * scale * std::sin(a) + 5.0 * scale);
+  }
+  return to_path(u);
+}
+
+TEST(NestFit, SimplifiedOutsideHoldsTheRingCloselyWithFewerCorners) {
+  const Path u = vase_u(300);
+  ASSERT_FALSE(detail::is_convex(u));
+  const Path s = detail::simplified_outside(u);
+  EXPECT_LT(s.size(), u.size() / 2) << "the many corners of the arcs should go";
+  EXPECT_EQ(area_of(clip(ClipperLib::ctDifference, {u}, {s})), 0.0) << "the proxy must hold the ring";
+  // No farther out than 75 µm anywhere: inside the ring grown by that much.
+  EXPECT_EQ(area_of(clip(ClipperLib::ctDifference, {s}, detail::offset_mitre({u}, 0.075))), 0.0);
+  EXPECT_EQ(detail::outer_proxy(u), s);  // the U is far from its hull: outer_proxy simplifies it
+}
+
+TEST(NestFit, WithoutNoFitEqualsSubtractingEachNoFitRegion) {
+  // Concave and convex children and candidates, the fit region small and large: the windowed,
+  // un-united pieces take exactly what the whole no-fit regions take.
+  const Path big = detail::convex_hull(to_path(circle(140, 64)));
+  const Path u = vase_u(40, 0.5);
+  const Path l_shape = to_path(ell(30, 20, 8, -10, -10));
+  const std::vector<Path> children{detail::translated(u, {-60'000'000, 20'000'000}),
+                                   detail::translated(l_shape, {50'000'000, -40'000'000}),
+                                   to_path(triangle(20, 15, 10, 60))};
+  for (const Path& c : {u, l_shape, to_path(rect(12, 8, -6, -4))}) {
+    const Paths fit = detail::inner_fit({big}, c);
+    ASSERT_FALSE(fit.empty());
+    const Paths small = clip(ClipperLib::ctIntersection, fit, {to_path(rect(40, 30, -50, -10))});
+    for (const Paths& f : {fit, small}) {
+      Paths want = f;
+      for (const Path& g : children) want = clip(ClipperLib::ctDifference, want, detail::minkowski_sum(g, detail::negated(c)));
+      const Paths got = detail::without_no_fit(f, children, c);
+      EXPECT_GT(area_of(got), 0.0);
+      EXPECT_LT(area_of(clip(ClipperLib::ctXor, got, want)), 1e-6) << area_of(got) << " vs " << area_of(want);
+    }
+  }
+}
+
+TEST(NestFit, ConvexRoomHoldsAConcaveRingExactlyWhenItHoldsItsHull) {
+  const Path room = to_path(circle(120, 40));
+  const Path u = vase_u(60, 0.8);
+  const Paths a = detail::inner_fit({room}, u);
+  const Paths b = detail::inner_fit_general({room}, u);
+  ASSERT_FALSE(a.empty());
+  EXPECT_LT(area_of(clip(ClipperLib::ctXor, a, b)), 1e-4) << area_of(a) << " vs " << area_of(b);
+}
+
 TEST(NestHoles, ComposedPlacementIsHostAfterChild) {
   const Placement host{0, 1.1, {300.0, -20.0}};
   const Placement child{1, 0.7, {12.0, 5.5}};
