@@ -11,7 +11,7 @@
 // report). A round costs one plan_bevels of the chosen layers and a DP over memoized estimates.
 //
 // Estimates that were too pessimistic are corrected too: in every round, at each chosen layer's
-// start, the next thicker sheet is planned as well (kept out of the DP's way of overlaps by
+// start that is within tolerance, the next thicker sheet is planned as well (kept out of the DP's way of overlaps by
 // planning the thicker layers in separate, non-overlapping batches).
 #include "layering_internal.hpp"
 
@@ -81,8 +81,9 @@ std::vector<Candidate> unmeasured(const Estimator& est, const LayerChoice& choic
   for (const ChosenLayer& l : choice.layers) {
     const int i = l.thickness_index;
     if (!est.is_measured(est.span(l.z_rel, t[static_cast<std::size_t>(i)]), i)) out.push_back({l.z_rel, i});
+    // Where the chosen sheet itself is out of tolerance a thicker one will not do better.
     const int thicker = i + 1;
-    if (thicker < static_cast<int>(t.size()) && l.z_rel + t[static_cast<std::size_t>(thicker)] <= est.height() + 1e-9 &&
+    if (l.within && thicker < static_cast<int>(t.size()) && l.z_rel + t[static_cast<std::size_t>(thicker)] <= est.height() + 1e-9 &&
         !est.is_measured(est.span(l.z_rel, t[static_cast<std::size_t>(thicker)]), thicker))
       out.push_back({l.z_rel, thicker});
   }

@@ -130,6 +130,29 @@ TEST(StackMesh, CurvedFormKinkIsARing) {
   EXPECT_NEAR(volume(stack_mesh(plan)), v, 1e-6 * v);
 }
 
+// Issue 17, item 8: every wall was meshed in rows at every sub-slice and midpoint (0.25 mm), so
+// a 2,174-triangle model's stack.stl had 1.2 M triangles. A wall that is one straight cut needs
+// its two faces only; a wall whose cuts kink keeps a ring there.
+TEST(StackMesh, AStraightCutWallIsOneRowAndAKinkedOneKeepsItsKink) {
+  const int n = 64;
+  // One sloped cut (20 → 16) read from ten sub-slices: walls 2·n triangles, caps 2·(n − 2).
+  std::vector<double> subs;
+  for (int k = 0; k <= 10; ++k) subs.push_back(k == 0 ? 0.001 : k == 10 ? 4.999 : 0.5 * k);
+  const BevelPlan straight = plan_of({make_layer(0, 0.0, 5.0, {circle_outline(20.0, n, {{20.0, 16.0}}, 0.0, 5.0)}, subs)});
+  reload(straight);
+  EXPECT_EQ(stack_mesh(straight).triangle_count(), static_cast<std::size_t>(2 * n + 2 * (n - 2)));
+  const double v = ngon_frustum_volume(n, 20.0, 16.0, 5.0);
+  EXPECT_NEAR(volume(stack_mesh(straight)), v, 1e-6 * v);
+
+  // Two crossing cuts (20 → 22 → 20): two rows of walls, the kink at mid-height kept.
+  const BevelPlan kinked =
+      plan_of({make_layer(0, 0.0, 5.0, {circle_outline(20.0, n, {{20.0, 24.0}, {24.0, 20.0}}, 0.0, 5.0)}, subs)});
+  reload(kinked);
+  EXPECT_EQ(stack_mesh(kinked).triangle_count(), static_cast<std::size_t>(4 * n + 2 * (n - 2)));
+  const double vk = 2.0 * ngon_frustum_volume(n, 20.0, 22.0, 2.5);
+  EXPECT_NEAR(volume(stack_mesh(kinked)), vk, 1e-6 * vk);
+}
+
 TEST(StackMesh, SeveralPartsInOneLayer) {
   const int n = 40;
   const Eigen::Vector2d a(-30, 0), b(30, 0);
