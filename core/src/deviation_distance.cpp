@@ -137,10 +137,15 @@ void wall_samples(const LayerPlan& layer, double ds, std::vector<Eigen::Vector3d
 
 namespace {
 
-// Samples of the stack's surface: walls and exposed faces.
-std::vector<Eigen::Vector3d> stack_samples(const BevelPlan& plan, double ds) {
+// An exposed face of the stack: a region at height z.
+struct FaceRegion {
+  ClipperLib::Paths region;
+  double z = 0.0;
+};
+
+// Samples of the stack's walls, and its exposed faces (sampled separately: refine_faces).
+std::vector<Eigen::Vector3d> stack_samples(const BevelPlan& plan, double ds, std::vector<FaceRegion>& faces) {
   std::vector<Eigen::Vector3d> out;
-  constexpr double kRegionBudget = 250000.0;
   for (std::size_t li = 0; li < plan.layers.size(); ++li) {
     const LayerPlan& layer = plan.layers[li];
     if (!usable_layer(layer)) continue;
@@ -152,12 +157,58 @@ std::vector<Eigen::Vector3d> stack_samples(const BevelPlan& plan, double ds) {
     ClipperLib::Paths top = section_paths(layer, layer.z_top_mm());
     if (li + 1 < plan.layers.size() && usable_layer(plan.layers[li + 1]))
       top = difference(top, section_paths(plan.layers[li + 1], plan.layers[li + 1].z_bottom_mm));
-    sample_region(top, layer.z_top_mm(), ds, kRegionBudget, out);
+    if (!top.empty()) faces.push_back({std::move(top), layer.z_top_mm()});
     ClipperLib::Paths bottom = section_paths(layer, zb);
     if (li > 0 && usable_layer(plan.layers[li - 1]))
       bottom = difference(bottom, section_paths(plan.layers[li - 1], plan.layers[li - 1].z_top_mm()));
-    sample_region(bottom, zb, ds, kRegionBudget, out);
+    if (!bottom.empty()) faces.push_back({std::move(bottom), zb});
   }
+  return out;
+}
+
+// Inside a region of positive fill: the winding of its paths about p is positive.
+bool in_region(const ClipperLib::Paths& region, const Eigen::Vector2d& p) {
+  const ClipperLib::IntPoint q(static_cast<ClipperLib::cInt>(std::llround(p.x() * kClipperUnitsPerMm)),
+                               static_cast<ClipperLib::cInt>(std::llround(p.y() * kClipperUnitsPerMm)));
+  int winding = 0;
+  for (const auto& path : region)
+    if (ClipperLib::PointInPolygon(q, path) != 0) winding += ClipperLib::Orientation(path) ? 1 : -1;
+  return winding > 0;
+}
+
+// The farthest point of each exposed face: its grid's farthest sample, then finer grids around
+// it (ds/8 over ±ds, then ds/64 over ±ds/8), kept inside the face. The coarse grid alone can miss
+// a maximum between its points (issue 17, item 8: a nosecone's top face read 0.500 mm where
+// 0.528 was true, off the axis).
+FarthestPoint farthest_on_faces(const TriangleTree& model, const std::vector<FaceRegion>& faces, double ds,
+                                bool parallel) {
+  constexpr double kRegionBudget = 250000.0;
+  std::vector<FarthestPoint> best(faces.size());
+  auto one = [&](std::size_t f) {
+    std::vector<Eigen::Vector3d> samples;
+    sample_region(faces[f].region, faces[f].z, ds, kRegionBudget, samples);
+    sort_morton(samples, false);
+    FarthestPoint b = max_distance(model, samples, false);
+    if (b.distance <= 0.0) return;
+    for (double step = ds / 8; step >= ds / 64; step /= 8) {
+      samples.clear();
+      for (int i = -8; i <= 8; ++i)
+        for (int j = -8; j <= 8; ++j) {
+          const Eigen::Vector2d p(b.at.x() + i * step, b.at.y() + j * step);
+          if (in_region(faces[f].region, p)) samples.emplace_back(p.x(), p.y(), faces[f].z);
+        }
+      const FarthestPoint finer = max_distance(model, samples, false);
+      if (finer.distance > b.distance) b = finer;
+    }
+    best[f] = b;
+  };
+  if (parallel)
+    tbb::parallel_for(std::size_t{0}, faces.size(), one);
+  else
+    for (std::size_t f = 0; f < faces.size(); ++f) one(f);
+  FarthestPoint out;
+  for (const FarthestPoint& b : best)
+    if (b.distance > out.distance) out = b;
   return out;
 }
 
@@ -202,10 +253,13 @@ FarthestPoint max_distance(const TriangleTree& tree, const std::vector<Eigen::Ve
 }
 
 FarthestPoint max_surface_distance(const Mesh& mesh, const BevelPlan& plan, const DeviationParams& params) {
-  std::vector<Eigen::Vector3d> samples = stack_samples(plan, params.distance_sample_mm);
+  std::vector<FaceRegion> faces;
+  std::vector<Eigen::Vector3d> samples = stack_samples(plan, params.distance_sample_mm, faces);
   sort_morton(samples, params.parallel);
   const TriangleTree model(mesh.vertices, mesh.faces, params.parallel);
-  const FarthestPoint stack_to_model = max_distance(model, samples, params.parallel);
+  FarthestPoint stack_to_model = max_distance(model, samples, params.parallel);
+  const FarthestPoint on_faces = farthest_on_faces(model, faces, params.distance_sample_mm, params.parallel);
+  if (on_faces.distance > stack_to_model.distance) stack_to_model = on_faces;
 
   samples = mesh.vertices;
   samples.reserve(samples.size() + mesh.faces.size());

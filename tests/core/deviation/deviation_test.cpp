@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -230,6 +231,46 @@ TEST(Deviation, ModelAboveTheStackIsFarAndMissing) {
   const double a = regular_polygon_area(seg, r);
   EXPECT_NEAR(d.volume_mm3, 6.0 * a, 1e-4 * 6.0 * a);
   EXPECT_NEAR(d.max_mm, 6.0, 1e-4);  // the model's top centre to the stack's top face
+}
+
+// Issue 17, item 8: a nosecone's max_mm read 0.500 where the true largest distance was 0.528,
+// on the last layer's top face, off the axis: the face was sampled on a 0.5 mm grid and its
+// farthest point lay between grid points. Here a block whose top is a V-groove along y, its
+// bottom at x = 0.3 (between the grid's columns, ±0.25 mm from it), 1 mm deep, under a flat layer
+// top: the farthest point of the stack's face is above the groove's bottom, 1·cos(atan(1/10.3))
+// from the groove's sides (no model vertex lies under it: they are at the block's ends).
+TEST(Deviation, AFacesFarthestPointBetweenGridPointsIsFound) {
+  const double x0 = 0.3, depth = 1.0;
+  TriangleSoup soup;
+  auto v = [](double x, double y, double z) { return Eigen::Vector3f(float(x), float(y), float(z)); };
+  auto tri = [&](Eigen::Vector3f a, Eigen::Vector3f b, Eigen::Vector3f c) { soup.corners.insert(soup.corners.end(), {a, b, c}); };
+  auto quad = [&](Eigen::Vector3f a, Eigen::Vector3f b, Eigen::Vector3f c, Eigen::Vector3f d) { tri(a, b, c), tri(a, c, d); };
+  const double h = 10.0, g = h - depth;
+  quad(v(-10, -10, 0), v(-10, 10, 0), v(10, 10, 0), v(10, -10, 0));        // bottom, facing down
+  quad(v(-10, -10, h), v(x0, -10, g), v(x0, 10, g), v(-10, 10, h));        // the groove's left side
+  quad(v(x0, -10, g), v(10, -10, h), v(10, 10, h), v(x0, 10, g));          // its right side
+  quad(v(-10, -10, 0), v(10, -10, 0), v(10, -10, h), v(-10, -10, h));      // y = -10
+  tri(v(-10, -10, h), v(10, -10, h), v(x0, -10, g));
+  quad(v(10, 10, 0), v(-10, 10, 0), v(-10, 10, h), v(10, 10, h));          // y = +10
+  tri(v(10, 10, h), v(-10, 10, h), v(x0, 10, g));
+  quad(v(-10, 10, 0), v(-10, -10, 0), v(-10, -10, h), v(-10, 10, h));      // x = -10
+  quad(v(10, -10, 0), v(10, 10, 0), v(10, 10, h), v(10, -10, h));          // x = +10
+  const Mesh mesh = mesh_test::build_checked(soup);
+  ASSERT_TRUE(mesh.summary.watertight);
+  const Deviation d = measure(mesh, plan_of({make_layer(0, 0.0, h, {dev_test::square_outline({0, 0}, 10.0, 0.0, h)})}));
+  // The truth, in the groove's cross-section: the largest over the face (z = h) of the distance
+  // to the two sides, by dense search.
+  auto segment_distance = [](Eigen::Vector2d p, Eigen::Vector2d a, Eigen::Vector2d b) {
+    const double t = std::clamp((p - a).dot(b - a) / (b - a).squaredNorm(), 0.0, 1.0);
+    return (p - (a + t * (b - a))).norm();
+  };
+  double truth = 0.0;
+  for (double x = -10.0; x <= 10.0; x += 1e-5) {
+    const Eigen::Vector2d p(x, h);
+    truth = std::max(truth, std::min(segment_distance(p, {-10, h}, {x0, g}), segment_distance(p, {x0, g}, {10, h})));
+  }
+  EXPECT_NEAR(truth, 0.995, 1e-3);
+  EXPECT_NEAR(d.max_mm, truth, 2e-4) << "found at " << d.max_at_mm.transpose();
 }
 
 TEST(Deviation, SphereWithCurvedFormLayers) {
