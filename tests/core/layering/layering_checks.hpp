@@ -77,7 +77,9 @@ inline void expect_well_formed(const Layering& l, const LayeringParams& p, doubl
     if (s.shortfall) {
       EXPECT_FALSE(s.within_tolerance);
       // (with a rack that limits sheets: the thinnest the rack still allows there)
-      if (p.supply.empty()) EXPECT_EQ(s.thickness_mm, thinnest) << "a shortfall layer uses the thinnest sheet";
+      if (p.supply.empty()) {
+        EXPECT_EQ(s.thickness_mm, thinnest) << "a shortfall layer uses the thinnest sheet";
+      }
     } else if (!s.within_tolerance && p.method == LayeringMethod::optimal) {
       EXPECT_TRUE(last) << "only the last layer is out of tolerance without a shortfall (where it ends)";
     }

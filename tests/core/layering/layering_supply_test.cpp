@@ -71,8 +71,9 @@ TEST(LayeringSupply, CountsOfTheRackBoundEachThicknessAndTheDpStaysOptimal) {
     expect_well_formed(*r, p);
     const auto used = layers_per_thickness(*r);
     for (const auto& [t, cap] : caps) EXPECT_LE(used.count(t) ? used.at(t) : 0, cap) << t << " mm";
-    if (method == LayeringMethod::optimal)
+    if (method == LayeringMethod::optimal) {
       EXPECT_EQ(static_cast<int>(r->layers.size()), fewest_layers_by_search(43.0, p.tolerance_mm, caps));
+    }
   }
 }
 
@@ -87,8 +88,11 @@ TEST(LayeringSupply, ALayerIsOnlyCutFromSheetsItFits) {
   auto r = choose_layers(mesh, p);
   ASSERT_TRUE(r.has_value()) << r.error().message;
   expect_well_formed(*r, p);
-  for (const LayerSpan& s : r->layers)
-    if (s.thickness_mm == 10.0) EXPECT_GE(s.z_bottom_mm, 10.0 - 1e-9) << "a 10 mm layer holds part of the base";
+  for (const LayerSpan& s : r->layers) {
+    if (s.thickness_mm == 10.0) {
+      EXPECT_GE(s.z_bottom_mm, 10.0 - 1e-9) << "a 10 mm layer holds part of the base";
+    }
+  }
   EXPECT_GE(layers_per_thickness(*r)[10.0], 2) << "the post is still cut from 10 mm sheets";
 }
 
