@@ -177,6 +177,12 @@ std::expected<Layering, Error> choose_layers(const Mesh& mesh, const LayeringPar
     out.layers.push_back(l);
   }
   out.stack_height_mm = out.layers.empty() ? 0.0 : out.layers.back().z_top_mm() - est.z_base();
+  if (!choice.plans.empty() && choice.plans.size() == out.layers.size()) {
+    auto plan = std::make_shared<BevelPlan>();
+    plan->fit = params.fit;
+    plan->layers = choice.plans;
+    out.plan = std::move(plan);
+  }
 
   // Shortfalls: runs of layers where no sheet met the tolerance (the thinnest was used); a last
   // layer out of tolerance only for where it ends is said below, not here.

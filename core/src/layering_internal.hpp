@@ -17,6 +17,7 @@
 // estimate reads the profile at the stations of its bottom slice, of its top slice and of every
 // slice inside it where the section changes abruptly (loops appear or vanish, a flat face) —
 // between those, the boundary stations' lines see the gradual changes of the surface.
+#include "lamina/core/bevel.hpp"
 #include "lamina/core/layering.hpp"
 #include "lamina/core/section_lines.hpp"
 #include "lamina/core/slice.hpp"
@@ -193,6 +194,7 @@ struct LayerChoice {
   std::vector<ChosenLayer> layers;
   double reached_mm = 0.0;
   bool state_limit = false;  // the rack's counts gave more DP states than kMaxDpStates
+  std::vector<LayerPlan> plans;  // layer_verified: the chosen layers as planned (empty: not all were)
 };
 
 // More (position, usage) states than this is a rack whose counts the DP cannot search.

@@ -20,6 +20,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <optional>
 
 namespace lamina::layering_detail {
@@ -42,10 +43,16 @@ struct Candidate {
   int thickness_index = 0;
 };
 
+// The plans made, by (start in µm, thickness index): the chosen layers' plans are handed on.
+using PlanCache = std::map<std::pair<std::int64_t, int>, LayerPlan>;
+std::pair<std::int64_t, int> plan_key(double z_rel, int thickness_index) {
+  return {std::llround(z_rel * 1e6), thickness_index};
+}
+
 // Plans the candidates (in batches of layers that do not overlap) and records each measure.
 // Returns how many were new.
 std::expected<int, Error> measure(Estimator& est, const Mesh& mesh, const detail::TriangleTree& model,
-                                  const LayeringParams& params, std::vector<Candidate> todo) {
+                                  const LayeringParams& params, std::vector<Candidate> todo, PlanCache& plans) {
   const std::vector<double>& t = est.thicknesses();
   std::sort(todo.begin(), todo.end(), [](const Candidate& a, const Candidate& b) { return a.z_rel < b.z_rel; });
   int fresh = 0;
@@ -68,6 +75,7 @@ std::expected<int, Error> measure(Estimator& est, const Mesh& mesh, const detail
     for (std::size_t i = 0; i < batch.size(); ++i) {
       const GridSpan span = est.span(batch[i].z_rel, t[static_cast<std::size_t>(batch[i].thickness_index)]);
       fresh += est.set_measured(span, batch[i].thickness_index, plan->layers[i].max_deviation_mm) ? 1 : 0;
+      plans.insert_or_assign(plan_key(batch[i].z_rel, batch[i].thickness_index), std::move(plan->layers[i]));
     }
     todo = std::move(rest);
   }
@@ -95,16 +103,27 @@ std::vector<Candidate> unmeasured(const Estimator& est, const LayerChoice& choic
 std::expected<LayerChoice, Error> layer_verified(Estimator& est, const Mesh& mesh, const LayeringParams& params) {
   LayerChoice choice = layer_optimal(est, params);
   std::optional<detail::TriangleTree> model;  // built once, for every round's plans
+  PlanCache plans;
   for (int round = 0; round < kMaxRounds; ++round) {
     if (choice.layers.empty() || choice.state_limit) break;
     const std::vector<Candidate> todo = unmeasured(est, choice);
     if (todo.empty()) break;  // every chosen layer stands on its measure
     if (!model) model.emplace(mesh.vertices, mesh.faces, params.parallel);
-    auto fresh = measure(est, mesh, *model, params, todo);
+    auto fresh = measure(est, mesh, *model, params, todo, plans);
     if (!fresh) return std::unexpected(fresh.error());
     if (*fresh == 0) break;
     est.restart();
     choice = layer_optimal(est, params);
+  }
+  // The chosen layers as planned, when every one was (the bevel phase need not plan them again).
+  for (std::size_t i = 0; i < choice.layers.size(); ++i) {
+    const auto it = plans.find(plan_key(choice.layers[i].z_rel, choice.layers[i].thickness_index));
+    if (it == plans.end()) {
+      choice.plans.clear();
+      break;
+    }
+    choice.plans.push_back(it->second);
+    choice.plans.back().index = static_cast<int>(i);
   }
   return choice;
 }

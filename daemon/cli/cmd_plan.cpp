@@ -134,10 +134,14 @@ int plan_on_rack(const Mesh& mesh, const PlanSettings& settings, const std::opti
 
     if (round == 0) progress.phase("planning bevels");
     t0 = Clock::now();
-    auto plan = plan_bevels(mesh, r.layering.layers, bevel_params(settings, settings.strategy));
+    if (r.layering.plan) {  // the layering planned its layers with these parameters already
+      r.plan = *r.layering.plan;
+    } else {
+      auto plan = plan_bevels(mesh, r.layering.layers, bevel_params(settings, settings.strategy));
+      if (!plan) return report_error(plan.error());
+      r.plan = std::move(*plan);
+    }
     r.timing.bevel += seconds_since(t0);
-    if (!plan) return report_error(plan.error());
-    r.plan = std::move(*plan);
     if (!cam_settings) break;
 
     if (round == 0) progress.phase("nesting and programs");

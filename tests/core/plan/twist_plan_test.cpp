@@ -77,6 +77,15 @@ TEST(TwistPlan, EveryLayersEstimateIsItsMeasureAndTheStackKeepsTheTolerance) {
     auto plan = plan_bevels(mesh, layering->layers, bevel_params(lp));
     ASSERT_TRUE(plan.has_value());
     ASSERT_EQ(plan->layers.size(), layering->layers.size());
+    // The layering hands on the plan it made of these layers: the same as planning them again.
+    ASSERT_TRUE(layering->plan);
+    ASSERT_EQ(layering->plan->layers.size(), plan->layers.size());
+    for (std::size_t i = 0; i < plan->layers.size(); ++i) {
+      EXPECT_EQ(layering->plan->layers[i].index, plan->layers[i].index);
+      EXPECT_EQ(layering->plan->layers[i].z_bottom_mm, plan->layers[i].z_bottom_mm);
+      EXPECT_EQ(layering->plan->layers[i].max_deviation_mm, plan->layers[i].max_deviation_mm);
+      EXPECT_EQ(layering->plan->layers[i].outlines.size(), plan->layers[i].outlines.size());
+    }
     for (std::size_t i = 0; i < plan->layers.size(); ++i) {
       const double estimate = layering->layers[i].estimated_deviation_mm;
       const double measure = plan->layers[i].max_deviation_mm;

@@ -9,10 +9,13 @@
 
 #include <cstdint>
 #include <expected>
+#include <memory>
 #include <string>
 #include <vector>
 
 namespace lamina {
+
+struct BevelPlan;
 
 enum class LayeringMethod : std::uint8_t { optimal, greedy };
 const char* layering_method_name(LayeringMethod method);
@@ -73,6 +76,10 @@ struct Layering {
   double stack_height_mm = 0.0;         // sheets + bonds: top of the last layer
   std::vector<Shortfall> shortfalls;
   std::vector<std::string> warnings;
+  // The optimal layering plans the layers it chooses (issue 17, item 4): their bevel plan, as
+  // plan_bevels(mesh, layers, BevelParams{fit, sub_slice_mm, tolerance_mm, parallel} with the
+  // other fields at their defaults) would make it; null when not every layer was planned.
+  std::shared_ptr<const BevelPlan> plan;
 };
 
 // Errors: invalid parameters (ErrorCode::invalid_argument), and a supply that cannot make a stack
