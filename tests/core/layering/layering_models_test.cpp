@@ -58,7 +58,9 @@ TEST_P(LayeringSharedModels, OptimalNeverUsesMoreLayersThanGreedyAtTheSameTolera
 
 // Issue 17, item 4: per layer, the layering's estimate and the plan's measure agree within 20 %
 // (the last layer's estimate also holds how far the stack ends from the model's top).
-TEST_P(LayeringSharedModels, EveryLayersEstimateIsThePlansMeasure) {
+class LayeringEstimateIsMeasure : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(LayeringEstimateIsMeasure, EveryLayersEstimateIsThePlansMeasure) {
   const std::filesystem::path path = std::filesystem::path(LAMINA_SHARED_MODELS) / GetParam();
   if (!std::filesystem::exists(path)) GTEST_SKIP() << "shared model not present: " << path;
   auto soup = read_mesh_file(path);
@@ -86,6 +88,14 @@ TEST_P(LayeringSharedModels, EveryLayersEstimateIsThePlansMeasure) {
     EXPECT_NEAR(estimate, measure, 0.2 * std::max(measure, 0.01)) << GetParam() << " layer " << i;
   }
 }
+
+// The flange (concave fillet, convex round, flat faces, holes) and the dome (a cap on a plinth);
+// the vase takes as long as both together and adds no kind of surface they lack.
+INSTANTIATE_TEST_SUITE_P(Issue, LayeringEstimateIsMeasure, ::testing::Values("flange.stl", "dome.stl"),
+                         [](const ::testing::TestParamInfo<const char*>& info) {
+                           std::string n = info.param;
+                           return n.substr(0, n.find('.'));
+                         });
 
 INSTANTIATE_TEST_SUITE_P(Issue, LayeringSharedModels, ::testing::Values("vase.stl", "flange.stl", "dome.stl"),
                          [](const ::testing::TestParamInfo<const char*>& info) {

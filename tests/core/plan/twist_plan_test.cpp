@@ -69,7 +69,8 @@ BevelParams bevel_params(const LayeringParams& lp) {
 
 TEST(TwistPlan, EveryLayersEstimateIsItsMeasureAndTheStackKeepsTheTolerance) {
   const Mesh mesh = twisted_prism(90.0);
-  for (double tol : {0.1, 0.2, 0.4}) {
+  // (0.1 gives 60 layers of 1 mm at 0.061 mm: the same check, four times the time)
+  for (double tol : {0.2, 0.4}) {
     SCOPED_TRACE(::testing::Message() << "tolerance " << tol);
     const LayeringParams lp = params(tol);
     auto layering = choose_layers(mesh, lp);
