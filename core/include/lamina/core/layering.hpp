@@ -2,7 +2,11 @@
 // Adaptive layers from stock (paper 3-1): which sheet thickness each layer of the stack is cut
 // from. The paper's greedy rule is kept as a baseline; the default is a dynamic programme over a
 // z grid that minimises the number of layers subject to each layer's *achievable* deviation
-// (after bevelling, at the tilt limit) being within tolerance.
+// (after bevelling, at the tilt limit) being within tolerance. Its grid estimates are a first
+// guess: the layers it chooses are planned and measured (3-D distance, as the plan reports it)
+// and the choice is made again on the measures until it stands on them (layering_verify.cpp).
+// The rack (LayeringParams::supply) bounds how many layers of a thickness may be used and which
+// layers a thickness's sheets can hold.
 #include "lamina/core/bevel_profile.hpp"
 #include "lamina/core/error.hpp"
 #include "lamina/core/mesh.hpp"
