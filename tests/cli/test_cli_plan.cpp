@@ -341,7 +341,7 @@ TEST(CliPlan, ASizeThatSuggestsTheWrongUnitsIsSaid) {
   EXPECT_EQ(r.exit_code, 0) << r.out;
   EXPECT_TRUE(has_text(r, "2.70 mm at its largest): if the file is in inches, give --units in (it would be 68.6 mm)"))
       << r.out;
-  r = lamina("plan " + quoted(plate) + " --units in --stock 5,10 --no-programs --out " + quoted(out.path));
+  r = lamina("plan " + quoted(plate) + " --units in --stock 10 --no-programs --out " + quoted(out.path));
   EXPECT_EQ(r.exit_code, 0) << r.out;
   EXPECT_TRUE(has_text(r, "larger than the 2500 mm sheet: if the file is in mm, give --units mm (it would be 120.0 mm"))
       << r.out;
