@@ -145,6 +145,24 @@ Error rack_error(const layering_detail::Estimator& est, const LayeringParams& pa
                            est.height(), choice.reached_mm, limits.empty() ? "no thickness fits" : limits)};
 }
 
+// Shortfalls: runs of layers where no sheet met the tolerance (the thinnest was used); a last
+// layer out of tolerance only for where it ends is said by the warnings, not here.
+std::vector<Shortfall> shortfall_runs(const std::vector<LayerSpan>& layers) {
+  std::vector<Shortfall> runs;
+  for (std::size_t i = 0; i < layers.size(); ++i) {
+    const LayerSpan& l = layers[i];
+    if (!l.shortfall) continue;
+    if (i > 0 && layers[i - 1].shortfall) {
+      Shortfall& s = runs.back();
+      s.z_to_mm = l.z_top_mm();
+      s.deviation_mm = std::max(s.deviation_mm, l.estimated_deviation_mm);
+    } else {
+      runs.push_back(Shortfall{l.z_bottom_mm, l.z_top_mm(), l.estimated_deviation_mm});
+    }
+  }
+  return runs;
+}
+
 }  // namespace
 
 std::expected<Layering, Error> choose_layers(const Mesh& mesh, const LayeringParams& params) {
@@ -184,19 +202,7 @@ std::expected<Layering, Error> choose_layers(const Mesh& mesh, const LayeringPar
     out.plan = std::move(plan);
   }
 
-  // Shortfalls: runs of layers where no sheet met the tolerance (the thinnest was used); a last
-  // layer out of tolerance only for where it ends is said below, not here.
-  for (std::size_t i = 0; i < out.layers.size(); ++i) {
-    const LayerSpan& l = out.layers[i];
-    if (!l.shortfall) continue;
-    if (i > 0 && out.layers[i - 1].shortfall) {
-      Shortfall& s = out.shortfalls.back();
-      s.z_to_mm = l.z_top_mm();
-      s.deviation_mm = std::max(s.deviation_mm, l.estimated_deviation_mm);
-    } else {
-      out.shortfalls.push_back(Shortfall{l.z_bottom_mm, l.z_top_mm(), l.estimated_deviation_mm});
-    }
-  }
+  out.shortfalls = shortfall_runs(out.layers);
 
   auto& w = out.warnings;
   w = std::move(stock_warnings);

@@ -300,6 +300,18 @@ std::vector<std::size_t> needed_heights(const std::vector<Rings>& rings, const s
   return kept;
 }
 
+// The rings (and their heights) reduced to those needed_heights keeps.
+void keep_needed_rings(std::vector<Rings>& rings, std::vector<double>& heights) {
+  std::vector<Rings> kept_rings;
+  std::vector<double> kept_heights;
+  for (std::size_t k : needed_heights(rings, heights)) {
+    kept_rings.push_back(std::move(rings[k]));
+    kept_heights.push_back(heights[k]);
+  }
+  rings = std::move(kept_rings);
+  heights = std::move(kept_heights);
+}
+
 void build_group(const LayerPlan& layer, const OutlineGroup& group, const std::vector<double>& all_heights,
                  StackShells& shells) {
   std::vector<const LayerOutline*> outlines{&layer.outlines[static_cast<std::size_t>(group.outer)]};
@@ -344,15 +356,8 @@ void build_group(const LayerPlan& layer, const OutlineGroup& group, const std::v
   }
   for (std::size_t k = seed + 1; k < nk; ++k) clean[k] = clamp_rings(raw[k], clean[k - 1], base);
   for (std::size_t k = seed; k-- > 0;) clean[k] = clamp_rings(raw[k], clean[k + 1], base);
-  {
-    const std::vector<std::size_t> kept = needed_heights(clean, heights);
-    std::vector<Rings> rings;
-    std::vector<double> hs;
-    for (std::size_t k : kept) rings.push_back(std::move(clean[k])), hs.push_back(heights[k]);
-    clean = std::move(rings);
-    heights = std::move(hs);
-    nk = heights.size();
-  }
+  keep_needed_rings(clean, heights);
+  nk = heights.size();
 
   // Vertices: height by height, ring by ring.
   std::size_t per_height = 0;

@@ -162,6 +162,24 @@ int plan_on_rack(const Mesh& mesh, const PlanSettings& settings, const std::opti
   return 0;
 }
 
+// The same layering cut three ways; the chosen strategy's plan is reused, not recomputed.
+std::expected<void, Error> measure_strategies(const Mesh& mesh, const PlanSettings& settings, PlanResult& r) {
+  for (const BevelStrategy s : {BevelStrategy::vertical, BevelStrategy::sloped, BevelStrategy::curved}) {
+    std::optional<BevelPlan> other;
+    if (s != settings.strategy) {
+      BevelParams geometry_only = bevel_params(settings, s);
+      geometry_only.measure_surface_distance = false;  // its stack is measured as a whole below
+      auto p = plan_bevels(mesh, r.layering.layers, geometry_only);
+      if (!p) return std::unexpected(p.error());
+      other = std::move(*p);
+    }
+    auto d = measure_deviation(mesh, other ? *other : r.plan, deviation_params(settings));
+    if (!d) return std::unexpected(d.error());
+    r.deviations.push_back({s, *d});
+  }
+  return {};
+}
+
 int run_plan(const PlanOptions& o, const CamOptions& cam_options) {
   const auto t_start = Clock::now();
   auto settings = resolve_plan_settings(o);
@@ -204,22 +222,9 @@ int run_plan(const PlanOptions& o, const CamOptions& cam_options) {
   if (int code = plan_on_rack(mesh, *settings, cam_settings, stock, title, std::move(stock_warnings), progress, r, cam))
     return code;
 
-  // The same layering cut three ways; the chosen strategy's plan is reused, not recomputed.
   progress.phase("measuring deviation");
   auto t0 = Clock::now();
-  for (const BevelStrategy s : {BevelStrategy::vertical, BevelStrategy::sloped, BevelStrategy::curved}) {
-    std::optional<BevelPlan> other;
-    if (s != settings->strategy) {
-      BevelParams geometry_only = bevel_params(*settings, s);
-      geometry_only.measure_surface_distance = false;  // its stack is measured as a whole below
-      auto p = plan_bevels(mesh, r.layering.layers, geometry_only);
-      if (!p) return report_error(p.error());
-      other = std::move(*p);
-    }
-    auto d = measure_deviation(mesh, other ? *other : r.plan, deviation_params(*settings));
-    if (!d) return report_error(d.error());
-    r.deviations.push_back({s, *d});
-  }
+  if (auto ok = measure_strategies(mesh, *settings, r); !ok) return report_error(ok.error());
   r.timing.deviation = seconds_since(t0);
 
   // Every file is made in memory first: a failure anywhere writes nothing.

@@ -14,6 +14,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <optional>
 #include <numbers>
 
 namespace lamina {
@@ -25,13 +26,22 @@ using layering_test::stock_params;
 
 class LayeringSharedModels : public ::testing::TestWithParam<const char*> {};
 
-TEST_P(LayeringSharedModels, OptimalNeverUsesMoreLayersThanGreedyAtTheSameTolerance) {
-  const std::filesystem::path path = std::filesystem::path(LAMINA_SHARED_MODELS) / GetParam();
-  if (!std::filesystem::exists(path)) GTEST_SKIP() << "shared model not present: " << path;
+// The shared model, built; nullopt when ../shared/models is absent (the caller skips).
+std::optional<Mesh> shared_model(const char* name) {
+  const std::filesystem::path path = std::filesystem::path(LAMINA_SHARED_MODELS) / name;
+  if (!std::filesystem::exists(path)) return std::nullopt;
   auto soup = read_mesh_file(path);
-  ASSERT_TRUE(soup.has_value()) << soup.error().message;
+  EXPECT_TRUE(soup.has_value()) << soup.error().message;
+  if (!soup) return std::nullopt;
   auto mesh = build_mesh(*soup, MeshParams{});
-  ASSERT_TRUE(mesh.has_value()) << mesh.error().message;
+  EXPECT_TRUE(mesh.has_value()) << mesh.error().message;
+  if (!mesh) return std::nullopt;
+  return std::move(*mesh);
+}
+
+TEST_P(LayeringSharedModels, OptimalNeverUsesMoreLayersThanGreedyAtTheSameTolerance) {
+  const auto mesh = shared_model(GetParam());
+  if (!mesh) GTEST_SKIP() << "shared model not present: " << GetParam();
 
   auto pg = stock_params(LayeringMethod::greedy);
   pg.fit.tilt_max_rad = 60.0 * std::numbers::pi / 180.0;
@@ -61,12 +71,8 @@ TEST_P(LayeringSharedModels, OptimalNeverUsesMoreLayersThanGreedyAtTheSameTolera
 class LayeringEstimateIsMeasure : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(LayeringEstimateIsMeasure, EveryLayersEstimateIsThePlansMeasure) {
-  const std::filesystem::path path = std::filesystem::path(LAMINA_SHARED_MODELS) / GetParam();
-  if (!std::filesystem::exists(path)) GTEST_SKIP() << "shared model not present: " << path;
-  auto soup = read_mesh_file(path);
-  ASSERT_TRUE(soup.has_value()) << soup.error().message;
-  auto mesh = build_mesh(*soup, MeshParams{});
-  ASSERT_TRUE(mesh.has_value()) << mesh.error().message;
+  const auto mesh = shared_model(GetParam());
+  if (!mesh) GTEST_SKIP() << "shared model not present: " << GetParam();
   auto p = stock_params(LayeringMethod::optimal);
   p.tolerance_mm = 0.2;
   auto layering = choose_layers(*mesh, p);
