@@ -103,7 +103,8 @@ void add_plan_options(CLI::App& cmd, PlanOptions& o) {
   cmd.add_option("--deviation-step", o.deviation_step_mm, "Spacing of the sections the deviation is integrated over (mm)")
       ->check(in_range(0.0, true, 1e308, "mm"))
       ->capture_default_str();
-  cmd.add_option("--out", o.out_dir, "Folder for stack.stl and report.json (created if missing)")->required();
+  cmd.add_option("--out", o.out_dir, "Folder for report.json, stack.stl and, unless --no-programs, each sheet's program and drawing "
+                 "(sheet-1.nc, sheet-1.svg, …); created if missing")->required();
   cmd.add_flag("--json", o.json, "Print the report as JSON on stdout instead of the tables");
   cmd.add_option("--progress-fd", o.progress_fd, "Write one JSON line per planning phase to this open file descriptor")
       ->check(CLI::NonNegativeNumber);
