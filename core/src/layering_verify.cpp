@@ -111,6 +111,7 @@ std::expected<LayerChoice, Error> layer_verified(Estimator& est, const Mesh& mes
     if (!model) model.emplace(mesh.vertices, mesh.faces, params.parallel);
     auto fresh = measure(est, mesh, *model, params, todo, plans);
     if (!fresh) return std::unexpected(fresh.error());
+    if (params.on_round) params.on_round(round + 1, kMaxRounds);
     if (*fresh == 0) break;
     est.restart();
     choice = layer_optimal(est, params);

@@ -2,6 +2,7 @@
 // The machine file (config/machine.toml): kinematics, post, motion limits, cutting defaults, the jet,
 // the feed model and nesting, read once and converted to core units (mm, s, rad, SI). Any key not
 // known is an error naming the file, the line and the key.
+#include "lamina/core/cam_settings.hpp"
 #include "lamina/core/error.hpp"
 #include "lamina/core/feed.hpp"
 #include "lamina/core/kinematics.hpp"
@@ -14,15 +15,6 @@
 #include <string_view>
 
 namespace lamina::cli {
-
-struct MachineConfig {
-  HeadKinematics head;
-  PostParams post;
-  ToolpathParams cutting;  // includes the jet and the feed model
-  NestParams nest;
-  double sheet_width_mm = 1250.0;   // for sheets known by thickness only
-  double sheet_length_mm = 2500.0;
-};
 
 // Errors: io_error (cannot read), parse_error ("FILE:LINE: what").
 std::expected<MachineConfig, Error> read_machine_file(const std::string& path);

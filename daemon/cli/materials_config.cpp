@@ -145,12 +145,4 @@ std::expected<MaterialsConfig, Error> load_materials(const std::string& path) {
   return parse_materials_toml(*text, path);
 }
 
-std::expected<Material, Error> find_material(const MaterialsConfig& config, std::string_view name) {
-  if (auto it = config.materials.find(name); it != config.materials.end()) return it->second;
-  std::string known;
-  for (const auto& [n, m] : config.materials) known += fmt::format("{}'{}'", known.empty() ? "" : ", ", n);
-  return std::unexpected(
-      Error{ErrorCode::invalid_argument, fmt::format("unknown material '{}' (known: {})", name, known)});
-}
-
 }  // namespace lamina::cli

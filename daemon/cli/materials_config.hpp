@@ -17,6 +17,7 @@
 //   machinability = 213                # Zeng & Kim N_m, > 0          }
 //
 // Any other key is an error naming the file, line and key.
+#include "lamina/core/cam_settings.hpp"
 #include "lamina/core/error.hpp"
 #include "lamina/core/feed.hpp"
 
@@ -28,16 +29,8 @@
 
 namespace lamina::cli {
 
-struct MaterialsConfig {
-  std::map<std::string, Material, std::less<>> materials;  // by name
-  JetSetup jet;
-};
-
 // Errors: io_error (cannot read), parse_error ("FILE:LINE: what").
 std::expected<MaterialsConfig, Error> load_materials(const std::string& path);
 std::expected<MaterialsConfig, Error> parse_materials_toml(std::string_view text, const std::string& source_name);
-
-// The material of that exact name; invalid_argument listing the known names otherwise.
-std::expected<Material, Error> find_material(const MaterialsConfig& config, std::string_view name);
 
 }  // namespace lamina::cli

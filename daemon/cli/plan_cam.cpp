@@ -1,6 +1,5 @@
 #include "plan_cam.hpp"
 
-#include "lamina/core/sheet_svg.hpp"
 
 #include <fmt/format.h>
 
@@ -11,15 +10,6 @@
 
 namespace lamina::cli {
 namespace {
-
-using Json = nlohmann::ordered_json;
-using Clock = std::chrono::steady_clock;
-
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
-constexpr double kDeg = std::numbers::pi / 180.0;
-
-// The material a sheet is cut as when neither --material nor the stock names one.
-constexpr const char* kDefaultMaterial = "aluminium 6061-T6";
 
 Error usage(std::string m) { return {ErrorCode::invalid_argument, std::move(m)}; }
 
@@ -99,176 +89,27 @@ std::expected<CamSettings, Error> resolve_cam_settings(const CamOptions& o) {
   return s;
 }
 
-Stock sized_stock(const Stock& stock, const MachineConfig& machine, std::vector<std::string>& warnings) {
-  Stock out = stock;
-  bool filled = false;
-  for (SheetStock& s : out.sheets)
-    if (s.width_mm <= 0.0 || s.length_mm <= 0.0) {
-      s.width_mm = machine.sheet_width_mm;
-      s.length_mm = machine.sheet_length_mm;
-      filled = true;
-    }
-  if (filled)
-    warnings.push_back(fmt::format("sheets given by thickness only are taken as {} x {} mm (machine file [nest]); give "
-                                   "sizes and counts with --stock-file",
-                                   machine.sheet_width_mm, machine.sheet_length_mm));
-  return out;
-}
-
-std::expected<CamResult, Error> plan_cam(const BevelPlan& plan, const Stock& stock, const CamSettings& settings,
-                                         const std::string& title, std::vector<SheetShortage>* shortages) {
-  CamResult r;
-  const MachineConfig& m = settings.machine;
-  auto t0 = Clock::now();
-  auto parts = make_parts(plan, settings.parts);
-  if (!parts) return std::unexpected(parts.error());
-  r.parts = std::move(*parts);
-  r.timing.parts = seconds_since(t0);
-
-  t0 = Clock::now();
-  auto nest = nest_parts(r.parts, stock, m.nest, shortages);
-  if (!nest) return std::unexpected(nest.error());
-  r.timing.nest = seconds_since(t0);
-
-  for (NestedSheet& sheet : nest->sheets) {
-    SheetOutput out;
-    out.material = !settings.material_override.empty() ? settings.material_override : sheet.material;
-    if (out.material.empty()) {
-      out.material = kDefaultMaterial;
-      if (r.warnings.empty() || r.warnings.back().find("no material") == std::string::npos)
-        r.warnings.push_back(fmt::format("sheets with no material are cut as {} (--material NAME to choose)", kDefaultMaterial));
-    }
-    sheet.material = out.material;  // what it is cut as, for the drawing's legend
-    auto material = find_material(settings.materials, out.material);
-    if (!material) return std::unexpected(Error{material.error().code, fmt::format("sheet {}: {}", sheet.index, material.error().message)});
-
-    t0 = Clock::now();
-    auto toolpath = plan_sheet_toolpath(plan, r.parts, sheet, *material, m.cutting);
-    if (!toolpath) return std::unexpected(toolpath.error());
-    r.timing.toolpath += seconds_since(t0);
-
-    t0 = Clock::now();
-    PostParams post = m.post;
-    post.program_number = m.post.program_number + sheet.index - 1;
-    post.title = fmt::format("{} sheet {} {}mm {}", title, sheet.index, sheet.thickness_mm, out.material);
-    auto program = post_program(*toolpath, m.head, post);
-    if (!program) return std::unexpected(Error{program.error().code, fmt::format("sheet {}: {}", sheet.index, program.error().message)});
-    r.timing.post += seconds_since(t0);
-
-    t0 = Clock::now();
-    SheetSvgParams svg;
-    svg.title = title;
-    svg.estimated_time_s = toolpath->time.total_s;
-    svg.dowel_diameter_mm = m.cutting.dowel_diameter_mm;
-    out.svg = sheet_svg(plan, r.parts, sheet, *toolpath, svg);
-    r.timing.svg += seconds_since(t0);
-
-    out.program_name = fmt::format("sheet-{}.nc", sheet.index);
-    out.svg_name = fmt::format("sheet-{}.svg", sheet.index);
-    out.sheet = std::move(sheet);
-    out.toolpath = std::move(*toolpath);
-    out.program = std::move(*program);
-    r.sheets.push_back(std::move(out));
-  }
-  return r;
-}
-
-Json sheets_json(const CamResult& r) {
-  Json sheets = Json::array();
-  for (const SheetOutput& s : r.sheets) {
-    Json parts = Json::array();
-    for (const Placement& pl : s.sheet.placements) {
-      const Part& p = r.parts[static_cast<std::size_t>(pl.part)];
-      parts.push_back({{"layer", p.layer},
-                       {"island", p.island},
-                       {"label", part_label(p)},
-                       {"x_mm", pl.offset_mm.x()},
-                       {"y_mm", pl.offset_mm.y()},
-                       {"rotation_deg", pl.rotation_rad / kDeg},
-                       {"inside", pl.host >= 0 ? Json(part_label(r.parts[static_cast<std::size_t>(
-                                                     s.sheet.placements[static_cast<std::size_t>(pl.host)].part)]))
-                                               : Json(nullptr)},
-                       {"dowels", p.dowels_mm.size()}});
-    }
-    const CutTime& t = s.toolpath.time;
-    const PostedProgram& prog = s.program;
-    sheets.push_back(
-        {{"index", s.sheet.index},
-         {"thickness_mm", s.sheet.thickness_mm},
-         {"width_mm", s.sheet.width_mm},
-         {"length_mm", s.sheet.length_mm},
-         {"material", s.material},
-         {"program", s.program_name},
-         {"svg", s.svg_name},
-         {"estimated_time_s", t.total_s},
-         {"time_s", {{"cutting", t.cutting_s}, {"rapids", t.rapid_s}, {"pierces", t.pierce_s}}},
-         {"cut_length_mm", t.cut_length_mm},
-         {"pierces", t.pierces},
-         {"contours", s.toolpath.contours.size()},
-         {"microjoints", s.toolpath.microjoints.size()},
-         {"utilisation", s.sheet.utilisation},
-         {"program_bytes", prog.text.size()},
-         {"program_lines", prog.lines},
-         {"five_axis_moves", prog.five_axis_moves},
-         {"bytes_per_five_axis_move",
-          prog.five_axis_moves ? Json(static_cast<double>(prog.five_axis_bytes) / prog.five_axis_moves) : Json(nullptr)},
-         {"parts", std::move(parts)}});
-  }
-  return sheets;
-}
-
-Json cam_json(const CamSettings& s, const CamResult& r) {
-  const MachineConfig& m = s.machine;
-  return {{"machine_file", s.machine_source},
-          {"materials_file", s.materials_source},
-          {"nest", nest_method_name(m.nest.method)},
-          {"spacing_mm", m.nest.spacing_mm},
-          {"margin_mm", m.nest.margin_mm},
-          {"fill_holes", m.nest.fill_holes},
-          {"post", post_dialect_name(m.post.dialect)},
-          {"rtcp", m.head.rtcp},
-          {"feed_model", feed_model_name(m.cutting.feed.model)},
-          {"quality", m.cutting.feed.quality},
-          {"kerf_mm", m.cutting.kerf_mm},
-          {"lead_in_mm", m.cutting.lead_in_mm},
-          {"lead_out_mm", m.cutting.lead_out_mm},
-          {"pierce_dwell_s", m.cutting.pierce_dwell_s},
-          {"microjoints", m.cutting.microjoints},
-          {"microjoint_width_mm", m.cutting.microjoint_width_mm},
-          {"dowels", s.parts.dowels.count},
-          {"dowel_diameter_mm", s.parts.dowels.diameter_mm},
-          {"parts", r.parts.size()},
-          {"timing_s",
-           {{"parts", r.timing.parts}, {"nest", r.timing.nest}, {"toolpath", r.timing.toolpath}, {"post", r.timing.post},
-            {"svg", r.timing.svg}}}};
-}
-
-void print_sheet_table(std::FILE* out, const Json& report) {
-  if (!report.contains("sheets")) return;
+void print_sheet_table(std::FILE* out, const PlanReport& report) {
+  if (!report.sheets || !report.cam) return;
   fmt::print(out, "{:>5} {:>6} {:>11} {:>5} {:>6} {:>7} {:>9} {:>8} {:>9} {:>7}  {}\n", "sheet", "t mm", "size mm",
              "parts", "util %", "pierces", "cut m", "time", "NC bytes", "B/5ax", "material");
   double total = 0.0;
-  for (const auto& s : report.at("sheets")) {
-    const double t = s.at("estimated_time_s").get<double>();
+  for (const ReportSheet& s : *report.sheets) {
+    const double t = s.estimated_time_s;
     total += t;
-    const auto& b = s.at("bytes_per_five_axis_move");
-    fmt::print(out, "{:>5} {:>6.3g} {:>11} {:>5} {:>6.1f} {:>7} {:>9.2f} {:>5}:{:02} {:>9} {:>7}  {}\n",
-               s.at("index").get<int>(), s.at("thickness_mm").get<double>(),
-               fmt::format("{:g}x{:g}", s.at("length_mm").get<double>(), s.at("width_mm").get<double>()),
-               s.at("parts").size(), 100.0 * s.at("utilisation").get<double>(), s.at("pierces").get<int>(),
-               s.at("cut_length_mm").get<double>() / 1000.0, static_cast<int>(t) / 60, static_cast<int>(t) % 60,
-               s.at("program_bytes").get<std::size_t>(), b.is_number() ? fmt::format("{:.1f}", b.get<double>()) : "-",
-               s.at("material").get<std::string>());
+    const auto& b = s.bytes_per_five_axis_move;
+    fmt::print(out, "{:>5} {:>6.3g} {:>11} {:>5} {:>6.1f} {:>7} {:>9.2f} {:>5}:{:02} {:>9} {:>7}  {}\n", s.index,
+               s.thickness_mm, fmt::format("{:g}x{:g}", s.length_mm, s.width_mm), s.parts.size(),
+               100.0 * s.utilisation, s.pierces, s.cut_length_mm / 1000.0, static_cast<int>(t) / 60,
+               static_cast<int>(t) % 60, s.program_bytes, b ? fmt::format("{:.1f}", *b) : "-", s.material);
   }
-  const auto& c = report.at("cam");
+  const ReportCam& c = *report.cam;
   fmt::print(out, "  {} sheets, {} parts, estimated cutting {}:{:02}:{:02} (h:m:s); {} nesting, {} post{}\n",
-             report.at("sheets").size(), c.at("parts").get<int>(), static_cast<int>(total) / 3600,
-             static_cast<int>(total) / 60 % 60, static_cast<int>(total) % 60, c.at("nest").get<std::string>(),
-             c.at("post").get<std::string>(), c.at("rtcp").get<bool>() ? " (RTCP)" : " (pivot coordinates, G93)");
-  const auto& t = c.at("timing_s");
+             report.sheets->size(), c.parts, static_cast<int>(total) / 3600, static_cast<int>(total) / 60 % 60,
+             static_cast<int>(total) % 60, c.nest, c.post, c.rtcp ? " (RTCP)" : " (pivot coordinates, G93)");
+  const ReportCamTiming& t = c.timing_s;
   fmt::print(out, "  timing: parts {:.3f} s, nest {:.3f} s, toolpaths {:.3f} s, post {:.3f} s, svg {:.3f} s\n\n",
-             t.at("parts").get<double>(), t.at("nest").get<double>(), t.at("toolpath").get<double>(),
-             t.at("post").get<double>(), t.at("svg").get<double>());
+             t.parts, t.nest, t.toolpath, t.post, t.svg);
 }
 
 }  // namespace lamina::cli

@@ -137,6 +137,7 @@ std::expected<PlanSettings, Error> resolve_plan_settings(const PlanOptions& o) {
   s.bond_mm = o.bond_mm;
   s.sub_slice_mm = o.sub_slice_mm;
   s.tolerance_mm = o.tolerance_mm;
+  s.tilt_max_deg = o.tilt_max_deg;
   s.tilt_max_rad = o.tilt_max_deg * std::numbers::pi / 180.0;  // the one degree → radian conversion
   s.deviation_step_mm = o.deviation_step_mm;
   s.side = side_from(o.side);
@@ -152,35 +153,6 @@ std::expected<PlanSettings, Error> resolve_plan_settings(const PlanOptions& o) {
                                      "approximate",
                                      s.deviation_step_mm, thinnest));
   return s;
-}
-
-LayeringParams layering_params(const PlanSettings& s) {
-  LayeringParams p;
-  p.thicknesses_mm = s.thicknesses_mm;
-  p.bond_mm = s.bond_mm;
-  p.sub_slice_mm = s.sub_slice_mm;
-  p.tolerance_mm = s.tolerance_mm;
-  p.method = s.layering;
-  p.fit.side = s.side;
-  p.fit.strategy = s.strategy;
-  p.fit.tilt_max_rad = s.tilt_max_rad;
-  return p;
-}
-
-BevelParams bevel_params(const PlanSettings& s, BevelStrategy strategy) {
-  BevelParams p;
-  p.fit.side = s.side;
-  p.fit.strategy = strategy;
-  p.fit.tilt_max_rad = s.tilt_max_rad;
-  p.sub_slice_mm = s.sub_slice_mm;
-  p.tolerance_mm = s.tolerance_mm;
-  return p;
-}
-
-DeviationParams deviation_params(const PlanSettings& s) {
-  DeviationParams p;
-  p.step_mm = s.deviation_step_mm;
-  return p;
 }
 
 }  // namespace lamina::cli

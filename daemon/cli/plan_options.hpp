@@ -2,10 +2,8 @@
 // `lamina plan` options: as typed (mm and degrees, the stock as text or a file) and, once
 // validated, in the units the core uses (mm and radians). Plan lengths are always millimetres;
 // --units is the model file's unit only.
-#include "lamina/core/bevel.hpp"
-#include "lamina/core/deviation.hpp"
 #include "lamina/core/error.hpp"
-#include "lamina/core/layering.hpp"
+#include "lamina/core/plan_job.hpp"
 #include "lamina/core/stock.hpp"
 #include "model_loading.hpp"
 
@@ -38,21 +36,7 @@ struct PlanOptions {
   int progress_fd = -1;                   // --progress-fd: phase lines for laminad (plan_progress.hpp)
 };
 
-// Validated, in core units.
-struct PlanSettings {
-  Stock stock;                        // from --stock-file, or --stock (sheets of unknown size)
-  std::string stock_source;           // "default", "--stock", or the file's path
-  std::vector<double> thicknesses_mm; // distinct, ascending
-  double bond_mm = 0.0;
-  double sub_slice_mm = 0.5;
-  double tolerance_mm = 0.2;
-  double tilt_max_rad = 0.0;
-  double deviation_step_mm = 0.1;
-  CutSide side = CutSide::outside;
-  BevelStrategy strategy = BevelStrategy::curved;
-  LayeringMethod layering = LayeringMethod::optimal;
-  std::vector<std::string> warnings;  // settings that are allowed but doubtful
-};
+// Validated, in core units: PlanSettings (lamina/core/plan_job.hpp).
 
 void add_plan_options(CLI::App& cmd, PlanOptions& o);
 
@@ -62,8 +46,5 @@ std::expected<std::vector<double>, std::string> parse_thickness_list(std::string
 // Reads the stock file when given; errors name the file (and line).
 std::expected<PlanSettings, Error> resolve_plan_settings(const PlanOptions& o);
 
-LayeringParams layering_params(const PlanSettings& s);
-BevelParams bevel_params(const PlanSettings& s, BevelStrategy strategy);
-DeviationParams deviation_params(const PlanSettings& s);
 
 }  // namespace lamina::cli

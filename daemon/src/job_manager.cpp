@@ -458,37 +458,35 @@ void JobManager::planner_loop() {
   }
 }
 
-// report.json's sheets and summary into the job (under mutex_); false when it has no sheet.
-bool JobManager::take_plan(JobRecord& job, const nlohmann::json& r) {
+// The plan's sheets and summary into the job (under mutex_); false when it has no sheet.
+bool JobManager::take_plan(JobRecord& job, const PlanReport& r) {
   job.sheets.clear();
   std::size_t lines = 0;
   double estimate_s = 0;
-  for (const auto& s : r.value("sheets", nlohmann::json::array())) {
+  for (const ReportSheet& s : r.sheets.value_or(std::vector<ReportSheet>{})) {
     SheetRecord sheet;
-    sheet.index = s.value("index", 0);
-    sheet.program_path = (fs::path(job.artefact_dir) / s.value("program", "")).string();
-    sheet.svg_path = (fs::path(job.artefact_dir) / s.value("svg", "")).string();
-    sheet.material = s.value("material", "");
-    sheet.thickness_mm = s.value("thickness_mm", 0.0);
+    sheet.index = static_cast<int>(s.index);
+    sheet.program_path = (fs::path(job.artefact_dir) / s.program).string();
+    sheet.svg_path = (fs::path(job.artefact_dir) / s.svg).string();
+    sheet.material = s.material;
+    sheet.thickness_mm = s.thickness_mm;
     std::ifstream in(sheet.program_path);
     for (std::string line; std::getline(in, line);) sheet.lines_total += !line.empty() && line != "\r";
     lines += sheet.lines_total;
-    estimate_s += s.value("estimated_time_s", 0.0);
+    estimate_s += s.estimated_time_s;
     job.sheets.push_back(std::move(sheet));
   }
   if (job.sheets.empty()) return false;
   nlohmann::json deviation = nlohmann::json::object();
-  const nlohmann::json deviations = r.value("deviation", nlohmann::json::object());  // named: items() keeps a reference
-  for (const auto& [strategy, d] : deviations.items())
-    deviation[strategy] = {{"volume_pct", d.value("volume_pct", 0.0)}, {"max_mm", d.value("max_mm", 0.0)}};
-  job.summary = {{"layers", r.contains("layers") ? r["layers"].size() : 0},
+  for (const auto& [strategy, d] : r.deviation) deviation[strategy] = {{"volume_pct", d.volume_pct}, {"max_mm", d.max_mm}};
+  job.summary = {{"layers", r.layers.size()},
                  {"sheets", job.sheets.size()},
                  {"lines", lines},
                  {"estimated_cut_s", estimate_s},
                  {"deviation", deviation},
                  {"stack", (fs::path(job.artefact_dir) / "stack.stl").string()},
                  {"report", (fs::path(job.artefact_dir) / "report.json").string()},
-                 {"warnings", r.value("warnings", nlohmann::json::array())}};
+                 {"warnings", r.warnings}};
   return true;
 }
 
@@ -519,6 +517,8 @@ void JobManager::plan_job(const std::string& id) {
       if (!job || job->state != JobState::planning) return;
       job->planning = {{"phase", phase.value("phase", "")}, {"step", phase.value("step", 0)},
                        {"steps", phase.value("steps", 0)}};
+      if (phase.contains("total"))  // a step inside the phase (issue 18): the bar moves within it
+        job->planning.update({{"done", phase.value("done", 0)}, {"total", phase.value("total", 0)}});
       j = to_json(*job);
     }
     if (notify_) notify_("notify_job_progress", j);

@@ -18,6 +18,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "lamina/core/plan_report.hpp"
 #include "lamina/daemon/daemon_config.hpp"
 #include "lamina/daemon/job_model.hpp"
 #include "lamina/daemon/job_store.hpp"
@@ -89,7 +90,7 @@ class JobManager {
   // --- threads ---
   void planner_loop();
   void plan_job(const std::string& id);
-  bool take_plan(JobRecord& job, const nlohmann::json& report);
+  bool take_plan(JobRecord& job, const PlanReport& report);
   void cut_sheet(std::string job_id, int sheet, CutStart how, std::vector<std::string> program,
                  std::optional<std::size_t> resume_line);
   void finish_cut(const std::string& job_id, int sheet, const drivers::CutReport& report);

@@ -120,7 +120,7 @@ pid_t spawn_limited(std::vector<char*>& argv, int log_fd, int progress_fd, const
 
 }  // namespace
 
-std::expected<nlohmann::json, PlanProcessError> run_plan_process(const PlanProcessRequest& r,
+std::expected<PlanReport, PlanProcessError> run_plan_process(const PlanProcessRequest& r,
                                                                  const std::atomic<bool>& cancel,
                                                                  const PlanProgressCallback& on_progress) {
   std::error_code ec;
@@ -191,13 +191,16 @@ std::expected<nlohmann::json, PlanProcessError> run_plan_process(const PlanProce
   if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
     return std::unexpected(PlanProcessError{false, fmt::format("planning failed: {}", tail_of_log(log))});
 
-  std::ifstream in(r.out_dir / "report.json");
+  std::ifstream in(r.out_dir / "report.json", std::ios::binary);
   if (!in) return std::unexpected(PlanProcessError{false, "the planner wrote no report.json"});
-  try {
-    return nlohmann::json::parse(in);
-  } catch (const std::exception& e) {
-    return std::unexpected(PlanProcessError{false, fmt::format("report.json: {}", e.what())});
-  }
+  const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  // Read with the planner's own schema (lamina/core/plan_report.hpp): a planner of another
+  // version, or a bug on one side, fails the job with the key that differs — never a sheet 0.
+  auto report = parse_plan_report(text);
+  if (!report)
+    return std::unexpected(PlanProcessError{false, fmt::format("the planner's report does not match this laminad: {}",
+                                                               report.error().message)});
+  return std::move(*report);
 }
 
 }  // namespace lamina::daemon

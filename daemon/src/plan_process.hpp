@@ -13,6 +13,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "lamina/core/plan_report.hpp"
+
 namespace lamina::daemon {
 
 // Limits of the child, set before it runs (setrlimit, nice): a huge or hostile model makes its
@@ -41,10 +43,11 @@ struct PlanProcessError {
 // One phase line of the planner (`lamina plan --progress-fd`): {phase, step, steps}.
 using PlanProgressCallback = std::function<void(const nlohmann::json&)>;
 
-// Blocking (a worker thread). Returns report.json as parsed. `cancel` is polled every 50 ms:
+// Blocking (a worker thread). Returns report.json as read by the planner's schema (a file that
+// does not match it is an error naming the key). `cancel` is polled every 50 ms:
 // SIGTERM, then SIGKILL 2 s later. `on_progress` (optional) runs on this thread as each phase
 // starts; the planner writes them to a pipe, a line that is not JSON is skipped.
-std::expected<nlohmann::json, PlanProcessError> run_plan_process(const PlanProcessRequest& request,
+std::expected<PlanReport, PlanProcessError> run_plan_process(const PlanProcessRequest& request,
                                                                  const std::atomic<bool>& cancel,
                                                                  const PlanProgressCallback& on_progress = {});
 

@@ -1,6 +1,7 @@
 // run_plan_process with a stand-in planner (a shell script in the place of `lamina`): the phase
 // lines it writes on its progress descriptor reach the callback in order, whole, garbage
-// skipped; its report is returned; a failing planner's error lines become the message.
+// skipped; its report is returned, read with the planner's schema (a report that does not match
+// fails loudly); a failing planner's error lines become the message.
 #include <gtest/gtest.h>
 
 #include <sys/stat.h>
@@ -21,6 +22,16 @@ std::string write_script(const TempDir& dir, const std::string& body) {
   const std::string path = dir.file("fake-lamina");
   std::ofstream(path) << "#!/bin/sh\n" << body;
   ::chmod(path.c_str(), 0755);
+  return path;
+}
+
+// A report as `lamina plan` writes it (the same serialisation), with `layers` layers.
+std::string valid_report(const TempDir& dir, int layers) {
+  PlanReport report;
+  report.layers.resize(static_cast<std::size_t>(layers));
+  report.deviation.emplace_back("curved", ReportDeviation{});
+  const std::string path = dir.file("valid-report.json");
+  std::ofstream(path) << plan_report_json(report);
   return path;
 }
 
@@ -45,13 +56,15 @@ printf '{"phase":"planning ' >&9
 sleep 0.2
 echo 'bevels","step":2,"steps":2}' >&9
 echo 'not a phase' >&9
-echo '{"sheets":[],"layers":[1,2,3]}' > "$4/report.json"
+cp "$9" "$4/report.json"
 )");
   std::atomic<bool> cancel{false};
   std::vector<nlohmann::json> seen;
-  auto report = run_plan_process(request_for(dir, planner), cancel, [&](const nlohmann::json& p) { seen.push_back(p); });
+  PlanProcessRequest request = request_for(dir, planner);
+  request.flags = {valid_report(dir, 3)};  // $9: the stand-in copies it
+  auto report = run_plan_process(request, cancel, [&](const nlohmann::json& p) { seen.push_back(p); });
   ASSERT_TRUE(report) << report.error().message;
-  EXPECT_EQ((*report)["layers"].size(), 3u);
+  EXPECT_EQ(report->layers.size(), 3u);
   ASSERT_EQ(seen.size(), 2u);
   EXPECT_EQ(seen[0]["phase"], "choosing layers");
   EXPECT_EQ(seen[1]["phase"], "planning bevels") << "a line split across writes arrives whole";
@@ -70,12 +83,35 @@ TEST(PlanProcess, AFailedPlannerGivesItsErrorLinesAndNoReport) {
 
 TEST(PlanProcess, APlannerThatIgnoresItsProgressPipeStillPlans) {
   TempDir dir;
-  const std::string planner = write_script(dir, "echo '{}' > \"$4/report.json\"\n");
+  const std::string planner = write_script(dir, "cp \"$9\" \"$4/report.json\"\n");
+  PlanProcessRequest request = request_for(dir, planner);
+  request.flags = {valid_report(dir, 1)};
   std::atomic<bool> cancel{false};
   int calls = 0;
-  auto report = run_plan_process(request_for(dir, planner), cancel, [&](const nlohmann::json&) { ++calls; });
+  auto report = run_plan_process(request, cancel, [&](const nlohmann::json&) { ++calls; });
   ASSERT_TRUE(report) << report.error().message;
   EXPECT_EQ(calls, 0);
+}
+
+// Issue 18: laminad read report.json with value(key, default), so a renamed field became sheet 0
+// or an empty path without a word. A report that does not match the schema fails the plan, and
+// the message names the key.
+TEST(PlanProcess, AReportThatDoesNotMatchTheSchemaIsRefusedNamingTheKey) {
+  TempDir dir;
+  const std::string good = valid_report(dir, 2);
+  std::ifstream in(good);
+  std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  const std::string renamed = dir.file("renamed.json");
+  const auto at = text.find("\"shortfalls\"");
+  ASSERT_NE(at, std::string::npos);
+  std::ofstream(renamed) << text.replace(at, 12, "\"short_falls\"");
+  const std::string planner = write_script(dir, "cp \"$9\" \"$4/report.json\"\n");
+  PlanProcessRequest request = request_for(dir, planner);
+  request.flags = {renamed};
+  std::atomic<bool> cancel{false};
+  auto report = run_plan_process(request, cancel);
+  ASSERT_FALSE(report);
+  EXPECT_NE(report.error().message.find("shortfalls: missing"), std::string::npos) << report.error().message;
 }
 
 }  // namespace
@@ -89,17 +125,20 @@ namespace {
 TEST(PlanProcess, ThePlannerRunsUnderItsLimits) {
   TempDir dir;
   const std::string planner = write_script(dir, R"(
-echo "{\"as_kb\": \"$(ulimit -v)\", \"cpu_s\": \"$(ulimit -t)\", \"nice\": $(nice), \"oom\": $(cat /proc/self/oom_score_adj)}" > "$4/report.json"
+echo "{\"as_kb\": \"$(ulimit -v)\", \"cpu_s\": \"$(ulimit -t)\", \"nice\": $(nice), \"oom\": $(cat /proc/self/oom_score_adj)}" > "$4/../limits.json"
+cp "$9" "$4/report.json"
 )");
   PlanProcessRequest r = request_for(dir, planner);
+  r.flags = {valid_report(dir, 1)};
   r.limits = {512ull << 20, 100, 7};
   std::atomic<bool> cancel{false};
   auto report = run_plan_process(r, cancel);
   ASSERT_TRUE(report) << report.error().message;
-  EXPECT_EQ((*report)["as_kb"], "524288");
-  EXPECT_EQ((*report)["cpu_s"], "100");
-  EXPECT_EQ((*report)["nice"], 7);
-  EXPECT_EQ((*report)["oom"], 1000);
+  const auto limits = nlohmann::json::parse(std::ifstream(dir.file("limits.json")));
+  EXPECT_EQ(limits["as_kb"], "524288");
+  EXPECT_EQ(limits["cpu_s"], "100");
+  EXPECT_EQ(limits["nice"], 7);
+  EXPECT_EQ(limits["oom"], 1000);
 }
 
 TEST(PlanProcess, APlannerOverItsCpuTimeIsStoppedAndTheMessageSaysWhy) {

@@ -13,6 +13,7 @@
 
 #include <cstdint>
 #include <expected>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -53,6 +54,9 @@ struct LayeringParams {
   double greedy_area_deviation = 0.15;
   double greedy_triangle_area_mm2 = 3.2258;
   bool parallel = true;
+  // Called after each round of the optimal layering's verification (done rounds of at most
+  // bound), on the calling thread: a progress bar's steps.
+  std::function<void(int done, int bound)> on_round;
 };
 
 struct LayerSpan {

@@ -1,11 +1,15 @@
-#include "plan_rack.hpp"
+// The rack as the layering sees it (issue 17, item 5): which thicknesses a layer may be cut from
+// (its outlines fit a sheet of that thickness) and how many layers each thickness holds. Counts
+// are learnt from the nesting: when it runs out of a thickness, that thickness is limited to the
+// layers its sheets held whole and the stack is laid out again.
+#include "lamina/core/plan_job.hpp"
 
 #include <fmt/format.h>
 
 #include <algorithm>
 #include <cmath>
 
-namespace lamina::cli {
+namespace lamina {
 namespace {
 
 constexpr double kSameThicknessMm = 1e-9;
@@ -67,4 +71,4 @@ bool lower_rack_limits(std::vector<ThicknessSupply>& supply, const std::vector<S
   return lowered;
 }
 
-}  // namespace lamina::cli
+}  // namespace lamina

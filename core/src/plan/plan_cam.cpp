@@ -1,0 +1,122 @@
+// The cut-program stage of a plan (issue 4): parts, nesting on the stock's sheets, one toolpath,
+// G-code program and SVG drawing per sheet.
+#include "lamina/core/plan_job.hpp"
+#include "lamina/core/sheet_svg.hpp"
+
+#include <fmt/format.h>
+
+#include <chrono>
+
+namespace lamina {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+// The material a sheet is cut as when neither --material nor the stock names one.
+constexpr const char* kDefaultMaterial = "aluminium 6061-T6";
+
+Error on_sheet_error(const NestedSheet& sheet, const Error& e) {
+  return Error{e.code, fmt::format("sheet {}: {}", sheet.index, e.message)};
+}
+
+// The material a sheet is cut as; says once when the default is taken.
+std::string material_of(const NestedSheet& sheet, const CamSettings& settings, std::vector<std::string>& warnings) {
+  std::string material = !settings.material_override.empty() ? settings.material_override : sheet.material;
+  if (!material.empty()) return material;
+  if (warnings.empty() || warnings.back().find("no material") == std::string::npos)
+    warnings.push_back(fmt::format("sheets with no material are cut as {} (--material NAME to choose)", kDefaultMaterial));
+  return kDefaultMaterial;
+}
+
+// One sheet's toolpath, program and drawing.
+std::expected<SheetOutput, Error> cut_sheet(const BevelPlan& plan, NestedSheet sheet, const CamSettings& settings,
+                                            const std::string& title, CamResult& r) {
+  const MachineConfig& m = settings.machine;
+  SheetOutput out;
+  out.material = material_of(sheet, settings, r.warnings);
+  sheet.material = out.material;  // what it is cut as, for the drawing's legend
+  auto material = find_material(settings.materials, out.material);
+  if (!material) return std::unexpected(on_sheet_error(sheet, material.error()));
+
+  auto t0 = Clock::now();
+  auto toolpath = plan_sheet_toolpath(plan, r.parts, sheet, *material, m.cutting);
+  if (!toolpath) return std::unexpected(toolpath.error());
+  r.timing.toolpath += seconds_since(t0);
+
+  t0 = Clock::now();
+  PostParams post = m.post;
+  post.program_number = m.post.program_number + sheet.index - 1;
+  post.title = fmt::format("{} sheet {} {}mm {}", title, sheet.index, sheet.thickness_mm, out.material);
+  auto program = post_program(*toolpath, m.head, post);
+  if (!program) return std::unexpected(on_sheet_error(sheet, program.error()));
+  r.timing.post += seconds_since(t0);
+
+  t0 = Clock::now();
+  SheetSvgParams svg;
+  svg.title = title;
+  svg.estimated_time_s = toolpath->time.total_s;
+  svg.dowel_diameter_mm = m.cutting.dowel_diameter_mm;
+  out.svg = sheet_svg(plan, r.parts, sheet, *toolpath, svg);
+  r.timing.svg += seconds_since(t0);
+
+  out.program_name = fmt::format("sheet-{}.nc", sheet.index);
+  out.svg_name = fmt::format("sheet-{}.svg", sheet.index);
+  out.sheet = std::move(sheet);
+  out.toolpath = std::move(*toolpath);
+  out.program = std::move(*program);
+  return out;
+}
+
+}  // namespace
+
+std::expected<Material, Error> find_material(const MaterialsConfig& config, std::string_view name) {
+  if (auto it = config.materials.find(name); it != config.materials.end()) return it->second;
+  std::string known;
+  for (const auto& [n, m] : config.materials) known += fmt::format("{}'{}'", known.empty() ? "" : ", ", n);
+  return std::unexpected(
+      Error{ErrorCode::invalid_argument, fmt::format("unknown material '{}' (known: {})", name, known)});
+}
+
+Stock sized_stock(const Stock& stock, const MachineConfig& machine, std::vector<std::string>& warnings) {
+  Stock out = stock;
+  bool filled = false;
+  for (SheetStock& s : out.sheets)
+    if (s.width_mm <= 0.0 || s.length_mm <= 0.0) {
+      s.width_mm = machine.sheet_width_mm;
+      s.length_mm = machine.sheet_length_mm;
+      filled = true;
+    }
+  if (filled)
+    warnings.push_back(fmt::format("sheets given by thickness only are taken as {} x {} mm (machine file [nest]); give "
+                                   "sizes and counts with --stock-file",
+                                   machine.sheet_width_mm, machine.sheet_length_mm));
+  return out;
+}
+
+std::expected<CamResult, Error> plan_cam(const BevelPlan& plan, const Stock& stock, const CamSettings& settings,
+                                         const std::string& title, std::vector<SheetShortage>* shortages,
+                                         const std::function<void(int, int)>& on_sheet) {
+  CamResult r;
+  auto t0 = Clock::now();
+  auto parts = make_parts(plan, settings.parts);
+  if (!parts) return std::unexpected(parts.error());
+  r.parts = std::move(*parts);
+  r.timing.parts = seconds_since(t0);
+
+  t0 = Clock::now();
+  auto nest = nest_parts(r.parts, stock, settings.machine.nest, shortages);
+  if (!nest) return std::unexpected(nest.error());
+  r.timing.nest = seconds_since(t0);
+
+  const int total = static_cast<int>(nest->sheets.size());
+  for (NestedSheet& sheet : nest->sheets) {
+    auto out = cut_sheet(plan, std::move(sheet), settings, title, r);
+    if (!out) return std::unexpected(out.error());
+    r.sheets.push_back(std::move(*out));
+    if (on_sheet) on_sheet(static_cast<int>(r.sheets.size()), total);
+  }
+  return r;
+}
+
+}  // namespace lamina

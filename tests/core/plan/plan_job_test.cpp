@@ -1,0 +1,168 @@
+// plan_job (issue 18): one entry point for every front end, one typed report that report.json
+// serialises and reads back with the same tables. A small sphere is planned whole (layers,
+// bevels, nesting, programs, deviation, stack), its report must read back to the same text, and
+// reports that do not match the schema are refused naming the key.
+#include "lamina/core/plan_job.hpp"
+#include "lamina/core/plan_report.hpp"
+
+#include "mesh_soups.hpp"
+
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+namespace lamina {
+namespace {
+
+const Mesh& ball() {
+  static const Mesh mesh = [] {
+    auto m = build_mesh(mesh_test::uv_sphere(20.0, 64, 32, Eigen::Vector3d(0, 0, 20)), MeshParams{});
+    return std::move(*m);
+  }();
+  return mesh;
+}
+
+PlanJobRequest request(bool with_programs) {
+  PlanJobRequest q;
+  q.settings.stock.sheets = {{2.5, 300, 300, 4, ""}, {5.0, 300, 300, 8, ""}};
+  q.settings.stock_source = "test";
+  q.settings.thicknesses_mm = {2.5, 5.0};
+  q.settings.tolerance_mm = 0.3;
+  q.settings.tilt_max_deg = 60.0;
+  q.settings.tilt_max_rad = 60.0 * 3.14159265358979 / 180.0;
+  q.settings.deviation_step_mm = 0.25;
+  q.model = {"ball.stl", "stl-binary", "mm", "z", {}, 0.0, 0.0};
+  if (with_programs) {
+    CamSettings cam;
+    cam.materials.materials.emplace("aluminium 6061-T6", Material{"aluminium 6061-T6", 2700, 0.0, 213});
+    cam.machine.head.rtcp = false;  // the default post is grblHAL's: pivot coordinates and G93
+    cam.parts.kerf_mm = cam.machine.cutting.kerf_mm;
+    cam.machine_source = "machine.toml";
+    cam.materials_source = "materials.toml";
+    q.cam = cam;
+  }
+  return q;
+}
+
+const PlanJobResult& planned() {
+  static const PlanJobResult r = [] {
+    auto p = plan_job(ball(), request(true));
+    if (p) return std::move(*p);
+    ADD_FAILURE() << plan_phase_name(p.error().phase) << ": " << p.error().error.message;
+    return PlanJobResult{};
+  }();
+  return r;
+}
+
+TEST(PlanJob, TheReportDescribesTheResult) {
+  const PlanJobResult& r = planned();
+  const PlanReport& report = r.report;
+  ASSERT_EQ(report.layers.size(), r.plan.layers.size());
+  EXPECT_GE(report.layers.size(), 8u);
+  EXPECT_NEAR(report.stack.stack_height_mm, r.layering.stack_height_mm, 0.0);
+  ASSERT_TRUE(r.cam && report.sheets && report.cam);
+  ASSERT_EQ(report.sheets->size(), r.cam->sheets.size());
+  for (std::size_t i = 0; i < r.cam->sheets.size(); ++i) {
+    EXPECT_EQ((*report.sheets)[i].program, r.cam->sheets[i].program_name);
+    EXPECT_EQ((*report.sheets)[i].program_bytes, static_cast<std::int64_t>(r.cam->sheets[i].program.text.size()));
+  }
+  ASSERT_EQ(report.deviation.size(), 3u);
+  EXPECT_EQ(report.deviation[2].first, "curved");
+  EXPECT_LT(report.deviation[2].second.volume_pct, report.deviation[0].second.volume_pct) << "curved beats vertical";
+  EXPECT_EQ(r.stack_stl.size(), 84u + 50u * ((r.stack_stl.size() - 84u) / 50u)) << "a whole binary STL";
+  EXPECT_GT(report.timing_s.total, 0.0);
+}
+
+TEST(PlanJob, ReportJsonReadsBackToTheSameText) {
+  const std::string text = plan_report_json(planned().report);
+  auto back = parse_plan_report(text);
+  ASSERT_TRUE(back) << back.error().message;
+  EXPECT_EQ(plan_report_json(*back), text);
+  EXPECT_EQ(back->sheets->front().parts.size(), planned().report.sheets->front().parts.size());
+}
+
+TEST(PlanJob, WithoutProgramsTheReportHasNoSheetsAndReadsBack) {
+  auto r = plan_job(ball(), request(false));
+  ASSERT_TRUE(r) << r.error().error.message;
+  EXPECT_FALSE(r->cam);
+  const std::string text = plan_report_json(r->report);
+  EXPECT_EQ(text.find("\"sheets\""), std::string::npos);
+  auto back = parse_plan_report(text);
+  ASSERT_TRUE(back) << back.error().message;
+  EXPECT_FALSE(back->sheets);
+}
+
+TEST(PlanJob, ProgressNamesEveryPhaseInOrderAndItsStepsGrow) {
+  std::vector<PlanStep> steps;
+  auto r = plan_job(ball(), request(true), [&](const PlanStep& s) { steps.push_back(s); });
+  ASSERT_TRUE(r) << r.error().error.message;
+  std::vector<PlanPhase> started;
+  for (const PlanStep& s : steps)
+    if (s.done == 0 && s.total == 0) started.push_back(s.phase);
+  EXPECT_EQ(started, (std::vector<PlanPhase>{PlanPhase::choosing_layers, PlanPhase::planning_bevels,
+                                             PlanPhase::nesting_and_programs, PlanPhase::measuring_deviation,
+                                             PlanPhase::writing_stack}));
+  int deviation_steps = 0, sheet_steps = 0, last_done = 0;
+  PlanPhase phase = PlanPhase::checking;
+  for (const PlanStep& s : steps) {
+    if (s.phase != phase) phase = s.phase, last_done = 0;
+    if (s.total == 0) continue;
+    EXPECT_GT(s.done, last_done) << plan_phase_name(s.phase);
+    EXPECT_LE(s.done, s.total) << plan_phase_name(s.phase);
+    last_done = s.done;
+    deviation_steps += s.phase == PlanPhase::measuring_deviation;
+    sheet_steps += s.phase == PlanPhase::nesting_and_programs;
+  }
+  EXPECT_EQ(deviation_steps, 3);
+  EXPECT_EQ(sheet_steps, static_cast<int>(r->cam->sheets.size()));
+}
+
+TEST(PlanJob, AnErrorSaysInWhichPhase) {
+  PlanJobRequest q = request(false);
+  q.settings.stock.sheets = {{100.0, 0, 0, 0, ""}};
+  q.settings.thicknesses_mm = {100.0};
+  auto r = plan_job(ball(), q);
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error().phase, PlanPhase::choosing_layers);
+  EXPECT_EQ(r.error().error.code, ErrorCode::invalid_argument);
+
+  q = request(false);
+  q.settings.deviation_step_mm = 1e-4;  // 400,000 sections over the ball's 40 mm
+  r = plan_job(ball(), q);
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error().phase, PlanPhase::checking);
+}
+
+// ---- the schema, one key at a time ----
+
+std::string with(std::string text, const std::string& from, const std::string& to) {
+  const auto at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  return at == std::string::npos ? text : text.replace(at, from.size(), to);
+}
+
+std::string error_of(const std::string& text) {
+  auto r = parse_plan_report(text);
+  return r ? std::string("(accepted)") : r.error().message;
+}
+
+TEST(PlanReportSchema, AMismatchIsRefusedWithTheKeysPath) {
+  const std::string text = plan_report_json(planned().report);
+  EXPECT_EQ(error_of(with(text, "\"program\":", "\"programme\":")),
+            "report.json: sheets[0].program: missing");
+  EXPECT_EQ(error_of(with(text, "\"index\": 1,\n      \"thickness_mm\"", "\"index\": \"1\",\n      \"thickness_mm\"")),
+            "report.json: sheets[0].index: expected an integer, found a string");
+  EXPECT_EQ(error_of(with(text, "\"warnings\": [", "\"warnings\": 1, \"extra\": [")),
+            "report.json: warnings: expected an array, found a number");
+  EXPECT_EQ(error_of(with(text, "\"stock_source\": \"test\",", "\"stock_source\": \"test\", \"colour\": 1,")),
+            "report.json: settings.colour: not a key of the report");
+  EXPECT_EQ(error_of(with(text, "\"within_tolerance\": ", "\"within_tolerance\": 1, \"was\": ")),
+            "report.json: layers[0].within_tolerance: expected a boolean, found a number");
+  EXPECT_NE(error_of(text.substr(0, text.size() / 2)).find("report.json: not JSON"), std::string::npos);
+  EXPECT_EQ(error_of(with(text, "\"direction\": null", "\"direction\": [0, 0, 1]")), "(accepted)")
+      << "an optional member is null or its value";
+}
+
+}  // namespace
+}  // namespace lamina
