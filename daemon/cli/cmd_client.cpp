@@ -71,6 +71,35 @@ std::string position_text(const Json& p) {
                      p.value("z_mm", 0.0), p.value("a_deg", 0.0), p.value("c_deg", 0.0));
 }
 
+// `lamina status`: state, position, feed, job with its sheet and line, a latched PLC alarm — in
+// words where the controller has not reported yet (no position) or there is no job, not dashes.
+std::string status_line(const Json& s) {
+  const std::string state = s.value("state", "unknown");
+  const bool reported = s.contains("position") && s["position"].is_object();
+  std::string line;
+  if (!reported) {
+    // The PLC may have read the CNC's state already; the position comes with the controller's report.
+    line = state == "unknown" ? "machine not connected yet" : fmt::format("{} (the PLC's reading of the CNC)", state);
+    line += ": waiting for the controller's first report";
+    if (s.contains("link") && s["link"].is_string()) line += fmt::format(" ({})", s["link"].get<std::string>());
+  } else {
+    line = fmt::format("{}  {}", state, position_text(s["position"]));
+    const Json feed = s.value("feed_mm_per_s", Json());
+    if (feed.is_number()) line += fmt::format("  F{:.0f} mm/min", feed.get<double>() * 60);
+  }
+  if (s.contains("job") && s["job"].is_string()) {
+    line += fmt::format("  job {}", s["job"].get<std::string>());
+    if (s.contains("sheet")) line += fmt::format(" sheet {}", s["sheet"].dump());
+    if (s.contains("program_line")) line += fmt::format(" line {}", s["program_line"].dump());
+  } else {
+    line += "  no job";
+  }
+  if (s.contains("cell") && s["cell"].value("alarm_latched", Json()) == true)
+    line += fmt::format("  PLC alarm {} latched", s["cell"].value("alarm_code", Json()).dump());
+  if (s.contains("cell") && s["cell"].contains("fault")) line += "  cell: " + s["cell"]["fault"].get<std::string>();
+  return line;
+}
+
 void print_job(const Json& j) {
   fmt::print("{}  {}  {}  sheet {}/{}{}\n", j.value("id", "?"), j.value("state", "?"), j.value("name", ""),
              j.value("current_sheet", 0), j.contains("sheets") && j["sheets"].is_array() ? j["sheets"].size() : 0,
@@ -311,13 +340,7 @@ void add_client_commands(CLI::App& app, int& exit_code) {
         exit_code = 1;
         return;
       }
-      print_or(*r, [](const Json& s) {
-        const Json feed = s.value("feed_mm_per_s", Json());
-        fmt::print("{}  {}  F{}  line {}  job {}{}\n", s.value("state", "?"), position_text(s.value("position", Json())),
-                   feed.is_number() ? fmt::format("{:.0f} mm/min", feed.get<double>() * 60) : std::string("-"),
-                   s.value("program_line", Json(0)).dump(), s.value("job", Json()).is_string() ? s["job"].get<std::string>() : "-",
-                   s.contains("cell") && s["cell"].contains("fault") ? "  cell: " + s["cell"]["fault"].get<std::string>() : "");
-      });
+      print_or(*r, [](const Json& s) { fmt::print("{}\n", status_line(s)); });
     });
   }
   for (const auto& [name, method, help] : std::vector<std::tuple<std::string, std::string, std::string>>{
