@@ -9,23 +9,27 @@
 
 namespace lamina {
 
-const char* cut_side_name(CutSide side) {
-  switch (side) {
-    case CutSide::outside: return "outside";
-    case CutSide::inside: return "inside";
-    case CutSide::mixed: return "mixed";
-  }
-  return "?";
+const ChoiceTable<CutSide>& cut_sides() {
+  static constexpr Choice<CutSide> rows[] = {
+      {CutSide::outside, "outside", "cuts leave material outside the surface (the part is never cut into)"},
+      {CutSide::inside, "inside", "cuts stay inside the surface (nothing stands proud of it)"},
+      {CutSide::mixed, "mixed", "cuts may cross the surface: the least deviation either way"}};
+  static constexpr ChoiceTable<CutSide> table{"cut side", rows};
+  return table;
 }
 
-const char* bevel_strategy_name(BevelStrategy strategy) {
-  switch (strategy) {
-    case BevelStrategy::curved: return "curved";
-    case BevelStrategy::sloped: return "sloped";
-    case BevelStrategy::vertical: return "vertical";
-  }
-  return "?";
+const ChoiceTable<BevelStrategy>& bevel_strategies() {
+  static constexpr Choice<BevelStrategy> rows[] = {
+      {BevelStrategy::curved, "curved", "several tangent cuts on convex edges, one on concave (the paper's form)"},
+      {BevelStrategy::sloped, "sloped", "one straight cut from the layer's bottom contour to its top"},
+      {BevelStrategy::vertical, "vertical", "a vertical cut (a 2-axis machine's staircase)"}};
+  static constexpr ChoiceTable<BevelStrategy> table{"bevel strategy", rows};
+  return table;
 }
+
+const char* cut_side_name(CutSide side) { return cut_sides().name_of(side); }
+
+const char* bevel_strategy_name(BevelStrategy strategy) { return bevel_strategies().name_of(strategy); }
 
 const char* profile_shape_name(ProfileShape shape) {
   switch (shape) {

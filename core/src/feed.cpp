@@ -74,6 +74,14 @@ std::expected<void, Error> check_cut(const FeedParams& params, double thickness_
 
 }  // namespace
 
+const ChoiceTable<FeedModel>& feed_models() {
+  static constexpr Choice<FeedModel> rows[] = {
+      {FeedModel::zeng_kim, "zeng-kim", "Zeng & Kim's machinability model, quality levels 1-5"},
+      {FeedModel::limbachiya_patel, "limbachiya-patel", "the paper's eq. 3 (specific energy of the material)"}};
+  static constexpr ChoiceTable<FeedModel> table{"feed model", rows};
+  return table;
+}
+
 const char* feed_model_name(FeedModel model) {
   switch (model) {
     case FeedModel::limbachiya_patel: return "limbachiya_patel";
@@ -85,6 +93,7 @@ const char* feed_model_name(FeedModel model) {
 std::expected<FeedModel, Error> parse_feed_model(std::string_view name) {
   for (FeedModel m : {FeedModel::limbachiya_patel, FeedModel::zeng_kim})
     if (name == feed_model_name(m)) return m;
+  if (auto typed = feed_models().parse(name)) return *typed;
   return std::unexpected(invalid(fmt::format("unknown feed model '{}' (known: limbachiya_patel, zeng_kim)", name)));
 }
 

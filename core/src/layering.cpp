@@ -10,13 +10,15 @@
 
 namespace lamina {
 
-const char* layering_method_name(LayeringMethod method) {
-  switch (method) {
-    case LayeringMethod::optimal: return "optimal";
-    case LayeringMethod::greedy: return "greedy";
-  }
-  return "?";
+const ChoiceTable<LayeringMethod>& layering_methods() {
+  static constexpr Choice<LayeringMethod> rows[] = {
+      {LayeringMethod::optimal, "optimal", "the fewest layers within tolerance (dynamic programme, verified by plans)"},
+      {LayeringMethod::greedy, "greedy", "the paper's rule: thickest sheet while its criteria hold"}};
+  static constexpr ChoiceTable<LayeringMethod> table{"layering method", rows};
+  return table;
 }
+
+const char* layering_method_name(LayeringMethod method) { return layering_methods().name_of(method); }
 
 namespace {
 

@@ -19,13 +19,15 @@
 
 namespace lamina {
 
-const char* nest_method_name(NestMethod method) {
-  switch (method) {
-    case NestMethod::matrix: return "matrix";
-    case NestMethod::shape: return "shape";
-  }
-  return "unknown";
+const ChoiceTable<NestMethod>& nest_methods() {
+  static constexpr Choice<NestMethod> rows[] = {
+      {NestMethod::shape, "shape", "true-shape nesting (libnest2d), parts in the holes of others"},
+      {NestMethod::matrix, "matrix", "the paper's rows of bounding boxes"}};
+  static constexpr ChoiceTable<NestMethod> table{"nesting method", rows};
+  return table;
 }
+
+const char* nest_method_name(NestMethod method) { return nest_methods().name_of(method); }
 
 Eigen::Vector2d place_point(const Placement& placement, const Eigen::Vector2d& layer_xy) {
   return detail::rotation_matrix(placement.rotation_rad) * layer_xy + placement.offset_mm;

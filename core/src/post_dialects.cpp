@@ -15,14 +15,18 @@
 
 namespace lamina {
 
-const char* post_dialect_name(PostDialect dialect) {
-  switch (dialect) {
-    case PostDialect::grblhal: return "grblhal";
-    case PostDialect::fanuc: return "fanuc";
-    case PostDialect::linuxcnc: return "linuxcnc";
-  }
-  return "unknown";
+const ChoiceTable<PostDialect, PostDialectTraits>& post_dialects() {
+  using Row = Choice<PostDialect, PostDialectTraits>;
+  static constexpr Row rows[] = {
+      {PostDialect::grblhal, "grblhal", "grblHAL: pivot coordinates and inverse-time feed (G93); no RTCP", {.controller = "grblHAL", .rtcp = false}},
+      {PostDialect::fanuc, "fanuc", "Fanuc: O-number, G43.4 tool-centre point when the head does RTCP", {.controller = "Fanuc", .rtcp = true}},
+      {PostDialect::linuxcnc, "linuxcnc", "LinuxCNC: TCP kinematics (switchable kins) or pivot coordinates",
+       {.controller = "LinuxCNC", .rtcp = true}}};
+  static constexpr ChoiceTable<PostDialect, PostDialectTraits> table{"post dialect", rows};
+  return table;
 }
+
+const char* post_dialect_name(PostDialect dialect) { return post_dialects().name_of(dialect); }
 
 namespace post_detail {
 
@@ -63,12 +67,12 @@ std::string m_code_line(const std::string& codes) {
 }
 
 std::expected<void, Error> check_post_setup(const HeadKinematics& head, const PostParams& params) {
-  if (params.dialect != PostDialect::grblhal && params.dialect != PostDialect::fanuc &&
-      params.dialect != PostDialect::linuxcnc)
-    return std::unexpected(Error{ErrorCode::invalid_argument, "unknown post dialect"});
-  if (head.rtcp && params.dialect == PostDialect::grblhal)
+  const auto* dialect = post_dialects().find(params.dialect);
+  if (!dialect) return std::unexpected(Error{ErrorCode::invalid_argument, "unknown post dialect"});
+  if (head.rtcp && !dialect->traits.rtcp)
     return std::unexpected(Error{ErrorCode::unsupported,
-                                 "grblhal has no RTCP (G43.4); post with head.rtcp = false (pivot coordinates, G93)"});
+                                 fmt::format("{} has no RTCP (G43.4); post with head.rtcp = false (pivot coordinates, G93)",
+                                             dialect->name)});
   if (params.linear_decimals < 0 || params.linear_decimals > 6 || params.angular_decimals < 0 ||
       params.angular_decimals > 6 || params.feed_decimals < 0 || params.feed_decimals > 4)
     return std::unexpected(Error{ErrorCode::invalid_argument,

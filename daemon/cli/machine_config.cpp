@@ -65,13 +65,15 @@ Reader flag(std::function<void(MachineConfig&, bool)> set) {
   };
 }
 
-Reader text(std::vector<std::string> allowed, std::function<void(MachineConfig&, const std::string&)> set) {
-  return [=](const toml::node& n, MachineConfig& c) -> std::optional<std::string> {
+// A name registered in one of core's choice tables (lamina/core/choices.hpp).
+template <class E, class Traits>
+Reader choice(const ChoiceTable<E, Traits>& table, std::function<void(MachineConfig&, E)> set) {
+  return [&table, set](const toml::node& n, MachineConfig& c) -> std::optional<std::string> {
     const auto* s = n.as_string();
     if (!s) return "must be a string";
-    if (!allowed.empty() && std::find(allowed.begin(), allowed.end(), s->get()) == allowed.end())
-      return fmt::format("= \"{}\" is not one of: {}", s->get(), fmt::join(allowed, ", "));
-    set(c, s->get());
+    const auto* row = table.find(s->get());
+    if (!row) return fmt::format("= \"{}\" is not one of: {}", s->get(), table.names_text());
+    set(c, row->value);
     return std::nullopt;
   };
 }
@@ -106,9 +108,7 @@ std::map<std::string, Section, std::less<>> sections() {
       {"rtcp", flag([](auto& c, bool v) { c.head.rtcp = v; })},
   };
   s["post"] = {
-      {"dialect", text({"grblhal", "fanuc", "linuxcnc"}, [](auto& c, const std::string& v) {
-         c.post.dialect = v == "fanuc" ? PostDialect::fanuc : v == "linuxcnc" ? PostDialect::linuxcnc : PostDialect::grblhal;
-       })},
+      {"dialect", choice<PostDialect>(post_dialects(), [](auto& c, PostDialect v) { c.post.dialect = v; })},
       {"linear_decimals", whole(1, 6, [](auto& c, long v) { c.post.linear_decimals = static_cast<int>(v); })},
       {"angular_decimals", whole(1, 6, [](auto& c, long v) { c.post.angular_decimals = static_cast<int>(v); })},
       {"jet_on", mcode([](auto& c, const std::string& v) { c.post.jet_on = v; })},
@@ -135,15 +135,11 @@ std::map<std::string, Section, std::less<>> sections() {
       {"part_on_right", flag([](auto& c, bool v) { c.cutting.part_on_right = v; })},
   };
   s["feed"] = {
-      {"model", text({"zeng-kim", "limbachiya-patel"}, [](auto& c, const std::string& v) {
-         c.cutting.feed.model = v == "limbachiya-patel" ? FeedModel::limbachiya_patel : FeedModel::zeng_kim;
-       })},
+      {"model", choice<FeedModel>(feed_models(), [](auto& c, FeedModel v) { c.cutting.feed.model = v; })},
       {"quality", whole(1, 5, [](auto& c, long v) { c.cutting.feed.quality = static_cast<int>(v); })},
   };
   s["nest"] = {
-      {"method", text({"shape", "matrix"}, [](auto& c, const std::string& v) {
-         c.nest.method = v == "matrix" ? NestMethod::matrix : NestMethod::shape;
-       })},
+      {"method", choice<NestMethod>(nest_methods(), [](auto& c, NestMethod v) { c.nest.method = v; })},
       {"spacing_mm", number(0, false, 1000, "mm", 1, [](auto& c, double v) { c.nest.spacing_mm = v; })},
       {"margin_mm", number(0, false, 1000, "mm", 1, [](auto& c, double v) { c.nest.margin_mm = v; })},
       {"fill_holes", flag([](auto& c, bool v) { c.nest.fill_holes = v; })},

@@ -20,11 +20,11 @@ void add_cam_options(CLI::App& cmd, CamOptions& o) {
   cmd.add_option("--materials", o.materials_file, "Materials file (TOML; default config/materials.toml)");
   cmd.add_option("--material", o.material, "Cut every sheet as this material (a name in the materials file)");
   cmd.add_option("--nest", o.nest, "Nesting: shape (true shape, libnest2d) or matrix (the paper's rows)")
-      ->check(CLI::IsMember({"shape", "matrix"}));
-  cmd.add_option("--post", o.post, "G-code dialect")->check(CLI::IsMember({"grblhal", "fanuc", "linuxcnc"}));
+      ->check(CLI::IsMember(nest_methods().names()));
+  cmd.add_option("--post", o.post, "G-code dialect")->check(CLI::IsMember(post_dialects().names()));
   cmd.add_option("--rtcp", o.rtcp, "The controller does RTCP (true: tip coordinates, G43.4) or not (false: pivot coordinates, G93)");
   cmd.add_option("--feed-model", o.feed_model, "Feed model: zeng-kim or limbachiya-patel (the paper's eq. 3)")
-      ->check(CLI::IsMember({"zeng-kim", "limbachiya-patel"}));
+      ->check(CLI::IsMember(feed_models().names()));
   cmd.add_option("--quality", o.quality, "Zeng–Kim quality level 1 (separation) … 5 (finest)")->check(CLI::Range(1, 5));
   cmd.add_option("--kerf", o.kerf_mm, "Kerf width (mm)")->check(CLI::Range(0.0, 10.0));
   cmd.add_option("--spacing", o.spacing_mm, "Clear gap between parts on a sheet (mm)")->check(CLI::Range(0.0, 1000.0));
@@ -54,11 +54,11 @@ std::expected<CamSettings, Error> resolve_cam_settings(const CamOptions& o) {
   s.machine.cutting.jet = s.materials.jet;  // the pump and head are described with the materials
 
   MachineConfig& m = s.machine;
-  if (o.nest) m.nest.method = *o.nest == "matrix" ? NestMethod::matrix : NestMethod::shape;
-  if (o.post)
-    m.post.dialect = *o.post == "fanuc" ? PostDialect::fanuc : *o.post == "linuxcnc" ? PostDialect::linuxcnc : PostDialect::grblhal;
+  // Names were checked against the same tables by the options (IsMember): parse cannot fail here.
+  if (o.nest) m.nest.method = nest_methods().parse(*o.nest).value();
+  if (o.post) m.post.dialect = post_dialects().parse(*o.post).value();
   if (o.rtcp) m.head.rtcp = *o.rtcp;
-  if (o.feed_model) m.cutting.feed.model = *o.feed_model == "limbachiya-patel" ? FeedModel::limbachiya_patel : FeedModel::zeng_kim;
+  if (o.feed_model) m.cutting.feed.model = feed_models().parse(*o.feed_model).value();
   if (o.quality) m.cutting.feed.quality = *o.quality;
   if (o.kerf_mm) m.cutting.kerf_mm = *o.kerf_mm;
   if (o.spacing_mm) m.nest.spacing_mm = *o.spacing_mm;
@@ -78,9 +78,14 @@ std::expected<CamSettings, Error> resolve_cam_settings(const CamOptions& o) {
     if (!found) return std::unexpected(usage("--material: " + found.error().message));
     s.material_override = *o.material;
   }
-  if (m.post.dialect == PostDialect::grblhal && m.head.rtcp)
-    return std::unexpected(usage("grblHAL has no RTCP (G43.4): use --rtcp false (pivot coordinates and G93), or "
-                                 "--post fanuc / linuxcnc for a controller that keeps the tool tip"));
+  if (const auto* dialect = post_dialects().find(m.post.dialect); m.head.rtcp && !dialect->traits.rtcp) {
+    std::vector<std::string_view> with_rtcp;
+    for (const auto& d : post_dialects().rows())
+      if (d.traits.rtcp) with_rtcp.push_back(d.name);
+    return std::unexpected(usage(fmt::format("{} has no RTCP (G43.4): use --rtcp false (pivot coordinates and G93), or "
+                                             "--post {} for a controller that keeps the tool tip",
+                                             dialect->traits.controller, fmt::join(with_rtcp, " / "))));
+  }
   // A pierce in the gap between two parts must not land in the neighbour.
   if (m.nest.spacing_mm < m.cutting.lead_in_mm + m.cutting.kerf_mm)
     return std::unexpected(usage(fmt::format(

@@ -18,16 +18,6 @@ std::string_view trimmed(std::string_view s) {
   return s;
 }
 
-CutSide side_from(const std::string& s) {
-  return s == "inside" ? CutSide::inside : s == "mixed" ? CutSide::mixed : CutSide::outside;
-}
-BevelStrategy strategy_from(const std::string& s) {
-  return s == "sloped" ? BevelStrategy::sloped : s == "vertical" ? BevelStrategy::vertical : BevelStrategy::curved;
-}
-LayeringMethod layering_from(const std::string& s) {
-  return s == "greedy" ? LayeringMethod::greedy : LayeringMethod::optimal;
-}
-
 // A number in [lo, hi] (lo excluded when `open_lo`), in `unit`; CLI11's own range message prints
 // DBL_MAX in full, this one says what is wanted.
 CLI::Validator in_range(double lo, bool open_lo, double hi, std::string unit) {
@@ -92,13 +82,13 @@ void add_plan_options(CLI::App& cmd, PlanOptions& o) {
       ->check(in_range(0.0, false, 89.0, "degrees"))
       ->capture_default_str();
   cmd.add_option("--side", o.side, "Which side of the surface cuts may lie on")
-      ->check(CLI::IsMember({"outside", "inside", "mixed"}))
+      ->check(CLI::IsMember(cut_sides().names()))
       ->capture_default_str();
   cmd.add_option("--strategy", o.strategy, "How layer edges are cut: curved form, one sloped chord, vertical")
-      ->check(CLI::IsMember({"curved", "sloped", "vertical"}))
+      ->check(CLI::IsMember(bevel_strategies().names()))
       ->capture_default_str();
   cmd.add_option("--layering", o.layering, "Layer choice: optimal (dynamic programme) or greedy (the paper's rule)")
-      ->check(CLI::IsMember({"optimal", "greedy"}))
+      ->check(CLI::IsMember(layering_methods().names()))
       ->capture_default_str();
   cmd.add_option("--deviation-step", o.deviation_step_mm, "Spacing of the sections the deviation is integrated over (mm)")
       ->check(in_range(0.0, true, 1e308, "mm"))
@@ -140,9 +130,15 @@ std::expected<PlanSettings, Error> resolve_plan_settings(const PlanOptions& o) {
   s.tilt_max_deg = o.tilt_max_deg;
   s.tilt_max_rad = o.tilt_max_deg * std::numbers::pi / 180.0;  // the one degree → radian conversion
   s.deviation_step_mm = o.deviation_step_mm;
-  s.side = side_from(o.side);
-  s.strategy = strategy_from(o.strategy);
-  s.layering = layering_from(o.layering);
+  auto side = cut_sides().parse(o.side);
+  auto strategy = bevel_strategies().parse(o.strategy);
+  auto layering = layering_methods().parse(o.layering);
+  for (const auto* e : {side ? nullptr : &side.error(), strategy ? nullptr : &strategy.error(),
+                        layering ? nullptr : &layering.error()})
+    if (e) return std::unexpected(*e);
+  s.side = *side;
+  s.strategy = *strategy;
+  s.layering = *layering;
   const double thinnest = s.thicknesses_mm.front();
   if (s.sub_slice_mm > thinnest)
     s.warnings.push_back(fmt::format("--sub-slice {} mm is more than the thinnest sheet ({} mm): layers of that "

@@ -5,6 +5,12 @@
 
 #include <fmt/format.h>
 
+#include "lamina/core/bevel_profile.hpp"
+#include "lamina/core/feed.hpp"
+#include "lamina/core/layering.hpp"
+#include "lamina/core/nest.hpp"
+#include "lamina/core/post.hpp"
+
 namespace lamina::daemon {
 namespace {
 
@@ -15,7 +21,7 @@ struct Setting {
   const char* flag;   // lamina plan flag
   Kind kind;
   double min = 0, max = 0;                  // numbers and integers
-  std::vector<const char*> choices = {};    // text: allowed values (empty: any non-empty text)
+  std::vector<std::string> choices = {};    // text: allowed values (empty: any non-empty text)
 };
 
 const std::vector<Setting>& settings_table() {
@@ -28,12 +34,14 @@ const std::vector<Setting>& settings_table() {
       {"sub_slice_mm", "--sub-slice", Kind::number, 0.01, 50},
       {"tolerance_mm", "--tolerance", Kind::number, 0.001, 50},
       {"tilt_max_deg", "--tilt-max", Kind::number, 0, 89},
-      {"side", "--side", Kind::text, 0, 0, {"outside", "inside", "mixed"}},
-      {"strategy", "--strategy", Kind::text, 0, 0, {"curved", "sloped", "vertical"}},
-      {"layering", "--layering", Kind::text, 0, 0, {"optimal", "greedy"}},
+      // Names of choices come from core's tables (lamina/core/choices.hpp), as the CLI's do.
+      {"side", "--side", Kind::text, 0, 0, cut_sides().names()},
+      {"strategy", "--strategy", Kind::text, 0, 0, bevel_strategies().names()},
+      {"layering", "--layering", Kind::text, 0, 0, layering_methods().names()},
       {"material", "--material", Kind::text},
-      {"nest", "--nest", Kind::text, 0, 0, {"shape", "matrix"}},
-      {"post", "--post", Kind::text, 0, 0, {"grblhal", "fanuc", "linuxcnc"}},
+      {"nest", "--nest", Kind::text, 0, 0, nest_methods().names()},
+      {"post", "--post", Kind::text, 0, 0, post_dialects().names()},
+      {"feed_model", "--feed-model", Kind::text, 0, 0, feed_models().names()},
       {"rtcp", "--rtcp", Kind::boolean},
       {"quality", "--quality", Kind::integer, 1, 5},
       {"kerf_mm", "--kerf", Kind::number, 0, 10},
@@ -90,10 +98,10 @@ std::expected<std::string, std::string> value_text(const Setting& s, const nlohm
         return std::unexpected(fmt::format("settings.{}: empty, too long or starting with '-'", s.key));
       if (!s.choices.empty()) {
         bool ok = false;
-        for (const char* c : s.choices) ok = ok || text == c;
+        for (const std::string& c : s.choices) ok = ok || text == c;
         if (!ok) {
           std::string list;
-          for (const char* c : s.choices) list += (list.empty() ? "" : ", ") + std::string(c);
+          for (const std::string& c : s.choices) list += (list.empty() ? "" : ", ") + c;
           return std::unexpected(fmt::format("settings.{}: '{}' is not one of {}", s.key, text, list));
         }
       }

@@ -1,4 +1,5 @@
 #pragma once
+#include "lamina/core/choices.hpp"
 // The cut lines of one station of a layer, in the station's profile plane (paper 3-3 to 3-5).
 //
 // A station is a point on a layer's outline with a horizontal outward unit normal n. The profile
@@ -29,6 +30,9 @@ enum class BevelStrategy : std::uint8_t { curved, sloped, vertical };
 // stays behind the chord (one chord cut). mixed: both (an inflection). empty: no sample.
 enum class ProfileShape : std::uint8_t { straight, convex, concave, mixed, empty };
 
+// Registered choices (choices.hpp): "outside", "inside", "mixed"; "curved", "sloped", "vertical".
+const ChoiceTable<CutSide>& cut_sides();
+const ChoiceTable<BevelStrategy>& bevel_strategies();
 const char* cut_side_name(CutSide side);
 const char* bevel_strategy_name(BevelStrategy strategy);
 const char* profile_shape_name(ProfileShape shape);

@@ -2,6 +2,7 @@
 // Abrasive waterjet feed models (paper eq. 3, and Zeng & Kim's machinability model). SI inside:
 // metres, kilograms, seconds, pascals; the result in mm/s. Inches, pounds, ksi and minutes exist
 // only where a published constant is defined in them, converted in one place (feed.cpp).
+#include "lamina/core/choices.hpp"
 #include "lamina/core/error.hpp"
 
 #include <cstdint>
@@ -13,6 +14,9 @@
 namespace lamina {
 
 enum class FeedModel : std::uint8_t { limbachiya_patel, zeng_kim };
+// As typed: "zeng-kim", "limbachiya-patel" (choices.hpp). feed_model_name() is report.json's
+// spelling ("zeng_kim"), kept since issue 4; parse_feed_model() reads either.
+const ChoiceTable<FeedModel>& feed_models();
 const char* feed_model_name(FeedModel model);  // "limbachiya_patel", "zeng_kim"
 // The model of a name feed_model_name gives; invalid_argument naming the known names otherwise.
 std::expected<FeedModel, Error> parse_feed_model(std::string_view name);

@@ -7,6 +7,7 @@
 // and the choice is made again on the measures until it stands on them (layering_verify.cpp).
 // The rack (LayeringParams::supply) bounds how many layers of a thickness may be used and which
 // layers a thickness's sheets can hold.
+#include "lamina/core/choices.hpp"
 #include "lamina/core/bevel_profile.hpp"
 #include "lamina/core/error.hpp"
 #include "lamina/core/mesh.hpp"
@@ -23,6 +24,7 @@ namespace lamina {
 struct BevelPlan;
 
 enum class LayeringMethod : std::uint8_t { optimal, greedy };
+const ChoiceTable<LayeringMethod>& layering_methods();  // "optimal", "greedy" (choices.hpp)
 const char* layering_method_name(LayeringMethod method);
 
 // What the rack can give of one thickness (issue 17, item 5): how many layers its sheets hold,

@@ -4,6 +4,7 @@
 // before thick). A placement maps a part's layer XY into the sheet frame:
 //   sheet_xy = R(rotation_rad) · layer_xy + offset_mm
 // Sheet frame: origin at the sheet's corner, x along its length, y along its width.
+#include "lamina/core/choices.hpp"
 #include "lamina/core/error.hpp"
 #include "lamina/core/parts.hpp"
 #include "lamina/core/stock.hpp"
@@ -19,6 +20,7 @@
 namespace lamina {
 
 enum class NestMethod : std::uint8_t { matrix, shape };
+const ChoiceTable<NestMethod>& nest_methods();  // "shape", "matrix" (choices.hpp)
 const char* nest_method_name(NestMethod method);
 
 struct NestParams {

@@ -3,6 +3,7 @@
 // Compact lines (modal words omitted, trailing zeros stripped, no spaces) because at 115200 baud
 // every byte is machine time. Contours are marked with a comment `(CONTOUR n ...)` at their pierce
 // so the machine link can resume at the start of a contour.
+#include "lamina/core/choices.hpp"
 #include "lamina/core/error.hpp"
 #include "lamina/core/kinematics.hpp"
 #include "lamina/core/toolpath.hpp"
@@ -16,6 +17,12 @@
 namespace lamina {
 
 enum class PostDialect : std::uint8_t { grblhal, fanuc, linuxcnc };
+// What a dialect's controller can do, as far as the post and its callers need to know.
+struct PostDialectTraits {
+  std::string_view controller;  // as its maker writes it: "grblHAL"
+  bool rtcp = false;  // keeps the tool tip itself (G43.4 or TCP kinematics); else pivot coordinates and G93
+};
+const ChoiceTable<PostDialect, PostDialectTraits>& post_dialects();  // "grblhal", "fanuc", "linuxcnc"
 const char* post_dialect_name(PostDialect dialect);
 
 struct PostParams {
