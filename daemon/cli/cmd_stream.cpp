@@ -21,7 +21,7 @@
 #include "commands.hpp"
 #include "lamina/drivers/cell_io.hpp"
 #include "lamina/drivers/cut_job.hpp"
-#include "lamina/drivers/modbus_block_link.hpp"
+#include "lamina/drivers/link_factory.hpp"
 #include "lamina/drivers/streamer.hpp"
 #include "stream_terminal.hpp"
 
@@ -92,58 +92,42 @@ void print_summary(const drivers::CutReport& report, drivers::MachineLink* link,
   }
 }
 
-// The link and the cell the options name (issue 18 will share this with laminad's session).
+// The link (built where laminad builds its own: drivers::make_link) and the cell the options name.
 struct StreamRig {
   std::unique_ptr<drivers::MachineLink> link;
+  const drivers::LinkProtocol* protocol = nullptr;
   std::unique_ptr<drivers::CellIo> cell;
   double line_bytes_per_s = 0;  // 0: not a serial line
 };
 
 // The rig, or the exit code after a usage error was printed.
 std::expected<StreamRig, int> build_rig(const StreamOptions& o) {
-  StreamRig rig;
-  if (o.protocol == "modbus") {
+  const drivers::LinkProtocol* protocol = drivers::find_link_protocol(o.protocol);  // --protocol was checked
+  drivers::LinkSettings settings{o.protocol, o.port, o.tcp, o.baud, o.rx_buffer, o.status_hz, o.stall_margin_s, {}};
+  if (protocol->traits.mailbox) {
     if (o.modbus.empty()) {
-      fmt::print(stderr, "lamina stream: --protocol modbus needs --modbus HOST:PORT\n");
+      fmt::print(stderr, "lamina stream: --protocol {} needs --modbus HOST:PORT\n", protocol->name);
       return std::unexpected(2);
     }
-    drivers::ModbusBlockSettings s;
-    std::tie(s.plc.host, s.plc.port) = split_host_port(o.modbus, "--modbus");
-    s.status_period_s = 1.0 / o.status_hz;
-    rig.link = std::make_unique<drivers::ModbusBlockLink>(s);
-    drivers::CellIoSettings cs;  // the same PLC minds the pump and interlocks
-    cs.plc = s.plc;
-    rig.cell = std::make_unique<drivers::CellIo>(cs);
-    return rig;
-  }
-  if (o.port.empty() == o.tcp.empty()) {
+    std::tie(settings.plc.host, settings.plc.port) = split_host_port(o.modbus, "--modbus");
+    settings.port.clear(), settings.tcp.clear();
+  } else if (o.port.empty() == o.tcp.empty()) {
     fmt::print(stderr, "lamina stream: give --port DEVICE or --tcp HOST:PORT\n");
     return std::unexpected(2);
+  } else if (!o.tcp.empty()) {
+    (void)split_host_port(o.tcp, "--tcp");  // a usage error in the flag's own words
   }
-  std::unique_ptr<drivers::LineProtocol> protocol;
-  if (o.protocol == "grbl") protocol = drivers::make_grbl_protocol({o.rx_buffer});
-  else if (o.protocol == "send-response") protocol = drivers::make_send_response_protocol();
-  else protocol = drivers::make_xonxoff_protocol();
-  drivers::StreamerSettings settings;
-  settings.status_period_s = o.protocol == "xonxoff" ? 0 : 1.0 / o.status_hz;
-  settings.stall_margin_s = o.stall_margin_s;
-  drivers::TransportFactory open;
-  if (!o.port.empty()) {
-    drivers::SerialSettings serial;
-    serial.baud = o.baud;
-    rig.line_bytes_per_s = o.baud / 10.0;  // 8N1
-    settings.pace_bytes_per_s = rig.line_bytes_per_s;
-    open = [port = o.port, serial](boost::asio::io_context& io) { return drivers::open_serial(io, port, serial); };
-  } else {
-    const auto [host, port] = split_host_port(o.tcp, "--tcp");
-    open = [host, port](boost::asio::io_context& io) { return drivers::open_tcp(io, host, port); };
+  auto built = drivers::make_link(settings);
+  if (!built) {
+    fmt::print(stderr, "lamina stream: {}\n", built.error());
+    return std::unexpected(2);
   }
-  rig.link = std::make_unique<drivers::Streamer>(std::move(open), std::move(protocol), settings);
-  if (!o.modbus.empty()) {
+  StreamRig rig{std::move(built->link), built->protocol, nullptr, built->line_bytes_per_s};
+  if (!o.modbus.empty()) {  // the same PLC minds the pump and interlocks
     drivers::CellIoSettings cs;
     std::tie(cs.plc.host, cs.plc.port) = split_host_port(o.modbus, "--modbus");
     rig.cell = std::make_unique<drivers::CellIo>(cs);
-  } else if (o.protocol == "xonxoff") {
+  } else if (!protocol->traits.reports_status) {
     // Without the PLC's jet output, a stop can only hold the feed; a drip feed has no reset
     // on its line that would turn the controller's jet M-code off.
     spdlog::warn("no --modbus: on a stop nothing turns the jet off (a drip feed has no reset on its line); "
@@ -167,8 +151,7 @@ int run_stream(const StreamOptions& o) {
   auto& link = rig->link;
   auto& cell = rig->cell;
 
-  drivers::CutJobSettings job_settings;
-  job_settings.wait_for_idle = o.protocol != "xonxoff";  // a drip feed reports no status
+  drivers::CutJobSettings job_settings = drivers::cut_settings_for(*rig->protocol);
   job_settings.hold_limit_s = o.hold_limit_s;
   job_settings.jet_restart_s = o.jet_restart_s;
   drivers::CutJob job(*link, cell.get(), *program, job_settings);
@@ -220,8 +203,8 @@ void add_stream_command(CLI::App& app, int& exit_code) {
   cmd->add_option("program", o->program, "G-code file")->required();
   cmd->add_option("--port", o->port, "serial device or USB serial number (see lamina ports)");
   cmd->add_option("--tcp", o->tcp, "the controller's TCP stream, HOST:PORT");
-  cmd->add_option("--protocol", o->protocol, "grbl | send-response | xonxoff | modbus")
-      ->check(CLI::IsMember({"grbl", "send-response", "xonxoff", "modbus"}));
+  cmd->add_option("--protocol", o->protocol, drivers::link_protocol_names_text())
+      ->check(CLI::IsMember(drivers::link_protocol_names()));
   cmd->add_option("--baud", o->baud, "serial speed (8N1)")->check(CLI::Range(300, 4000000));
   cmd->add_option("--rx-buffer", o->rx_buffer, "the controller's receive buffer (default: as it reports)");
   cmd->add_option("--modbus", o->modbus, "the cell PLC, HOST:PORT (and the mailbox for --protocol modbus)");

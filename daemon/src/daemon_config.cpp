@@ -185,7 +185,6 @@ constexpr std::array kPlannerKeys{"lamina"sv,    "workers"sv,          "machine"
                                   "timeout_s"sv, "memory_limit_mb"sv, "cpu_limit_s"sv, "nice"sv};
 constexpr std::array kJobsKeys{"roots"sv, "max_model_bytes"sv, "max_stock_file_bytes"sv, "upload_idle_s"sv,
                                "max_uploads"sv};
-constexpr std::array kProtocols{"grbl"sv, "send-response"sv, "xonxoff"sv, "modbus"sv};
 
 // token, or token_file's contents; false when token_file was given and could not be used.
 bool read_token(Section& s, ServerConfig& c) {
@@ -247,9 +246,8 @@ void read_server(Section s, ServerConfig& c) {
 
 void read_link(Section s, MachineLinkConfig& c) {
   s.string("protocol", c.protocol);
-  bool known = false;
-  for (const auto p : kProtocols) known = known || c.protocol == p;
-  if (!known) s.fail("protocol", fmt::format("\"{}\" is not one of {}", c.protocol, join(kProtocols)));
+  if (!drivers::find_link_protocol(c.protocol))
+    s.fail("protocol", fmt::format("\"{}\" is not one of {}", c.protocol, drivers::link_protocol_names_text()));
   s.string("port", c.port);
   s.host_port("tcp", c.tcp);
   s.integer("baud", c.baud, 300, 4'000'000);

@@ -6,9 +6,8 @@
 #include <boost/asio/io_context.hpp>
 #include <fmt/format.h>
 
-#include "lamina/drivers/modbus_block_link.hpp"
+#include "lamina/drivers/link_factory.hpp"
 #include "lamina/drivers/modbus_endpoint.hpp"
-#include "lamina/drivers/streamer.hpp"
 
 namespace lamina::daemon {
 namespace {
@@ -37,37 +36,16 @@ nlohmann::json position_json(const std::optional<std::array<double, 5>>& p) {
 }  // namespace
 
 MachineSession::MachineSession(const DaemonConfig& config)
-    : link_config_(config.link), hold_limit_s_(config.cell.hold_limit_s), jet_restart_s_(config.cell.jet_restart_s) {
-  const MachineLinkConfig& l = config.link;
-  if (l.protocol == "modbus") {
-    drivers::ModbusBlockSettings s;
-    s.plc = plc_endpoint(config.cell);
-    s.status_period_s = 1.0 / l.status_hz;
-    link_ = std::make_unique<drivers::ModbusBlockLink>(s);
-    describe_ = fmt::format("Modbus mailbox on {}", config.cell.modbus);
-  } else {
-    std::unique_ptr<drivers::LineProtocol> protocol;
-    if (l.protocol == "grbl") protocol = drivers::make_grbl_protocol({l.rx_buffer});
-    else if (l.protocol == "send-response") protocol = drivers::make_send_response_protocol();
-    else if (l.protocol == "xonxoff") protocol = drivers::make_xonxoff_protocol();
-    else throw std::invalid_argument(fmt::format("[link] protocol '{}' is unknown", l.protocol));
-    drivers::StreamerSettings settings;
-    settings.status_period_s = l.protocol == "xonxoff" ? 0 : 1.0 / l.status_hz;
-    settings.stall_margin_s = l.stall_margin_s;
-    drivers::TransportFactory open;
-    if (!l.port.empty()) {
-      drivers::SerialSettings serial;
-      serial.baud = l.baud;
-      settings.pace_bytes_per_s = l.baud / 10.0;  // 8N1
-      open = [port = l.port, serial](boost::asio::io_context& io) { return drivers::open_serial(io, port, serial); };
-      describe_ = fmt::format("{} on {} at {} baud", l.protocol, l.port, l.baud);
-    } else {
-      const auto [host, port] = host_port(l.tcp, "[link] tcp");
-      open = [host, port](boost::asio::io_context& io) { return drivers::open_tcp(io, host, port); };
-      describe_ = fmt::format("{} on tcp {}", l.protocol, l.tcp);
-    }
-    link_ = std::make_unique<drivers::Streamer>(std::move(open), std::move(protocol), settings);
-  }
+    : hold_limit_s_(config.cell.hold_limit_s), jet_restart_s_(config.cell.jet_restart_s) {
+  drivers::LinkSettings link = config.link;
+  if (drivers::find_link_protocol(link.protocol) && drivers::find_link_protocol(link.protocol)->traits.mailbox)
+    link.plc = plc_endpoint(config.cell);  // the mailbox is the cell PLC's
+  auto built = drivers::make_link(link);
+  if (!built) throw std::invalid_argument("[link] " + built.error());
+  link_ = std::move(built->link);
+  protocol_ = built->protocol;
+  describe_ = built->protocol->traits.mailbox ? fmt::format("Modbus mailbox on {}", config.cell.modbus)
+                                              : std::move(built->description);
   if (config.cell.enabled) {
     drivers::CellIoSettings cs;
     cs.plc = plc_endpoint(config.cell);
@@ -82,8 +60,7 @@ MachineSession::MachineSession(const DaemonConfig& config)
 }
 
 drivers::CutJobSettings MachineSession::cut_settings() const {
-  drivers::CutJobSettings s;
-  s.wait_for_idle = link_config_.protocol != "xonxoff";  // a drip feed reports no status
+  drivers::CutJobSettings s = drivers::cut_settings_for(*protocol_);
   s.hold_limit_s = hold_limit_s_;
   s.jet_restart_s = jet_restart_s_;
   return s;

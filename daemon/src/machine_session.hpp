@@ -25,7 +25,7 @@ class MachineSession {
   std::string describe() const;  // "grbl on /dev/ttyUSB0, PLC 10.0.0.5:502"
 
  private:
-  MachineLinkConfig link_config_;
+  const drivers::LinkProtocol* protocol_ = nullptr;
   double hold_limit_s_ = 600, jet_restart_s_ = 1.0;  // [cell]: what a feed hold does to the jet
   std::string describe_;
   std::unique_ptr<drivers::MachineLink> link_;

@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "lamina/drivers/link_factory.hpp"
+
 namespace lamina::daemon {
 
 struct ServerConfig {
@@ -24,15 +26,8 @@ struct ServerConfig {
   double pre_auth_timeout_s = 10;          // TCP: a valid token within this, or closed
 };
 
-struct MachineLinkConfig {
-  std::string protocol = "grbl";           // grbl | send-response | xonxoff | modbus
-  std::string port;                        // serial device or USB serial number
-  std::string tcp;                         // HOST:PORT of a networked controller
-  int baud = 115200;
-  std::size_t rx_buffer = 0;               // 0: as the controller reports
-  double status_hz = 5;
-  double stall_margin_s = 2;               // Idle with lines unanswered this long (+ a dwell's P): a stall
-};
+// [link]: the drivers' one link struct (lamina/drivers/link_factory.hpp); its `plc` is [cell]'s.
+using MachineLinkConfig = drivers::LinkSettings;
 
 struct CellConfig {
   bool enabled = true;                     // a PLC minds pump and interlocks
