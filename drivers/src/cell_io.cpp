@@ -65,6 +65,11 @@ struct CellIo::Impl {
 
   // Thread-only state.
   bool monitoring = false;  // between a successful prepare_cut and finish_cut: heartbeat + polling
+  // The heartbeat runs from the first prepared cut until the PLC is lost or CellIo ends, between
+  // cuts too (issue 18): the PLC's watchdog is there to catch a dead laminad, and stopping the
+  // beat after each sheet latched its alarm in every gap between sheets (then reset silently).
+  bool beating = false;
+  std::optional<Clock::time_point> last_beat_at;
   std::uint16_t heartbeat_value = 0;
   Clock::time_point next_heartbeat, next_poll;
   Clock::time_point next_idle_poll = Clock::now();
@@ -101,11 +106,10 @@ struct CellIo::Impl {
         continue;
       }
       if (monitoring && Clock::now() >= next_heartbeat) beat();
+      if (!monitoring && beating && Clock::now() >= next_heartbeat) idle_beat();
       if (monitoring && Clock::now() >= next_poll) poll();
       if (!monitoring && settings.idle_poll_period_s > 0 && Clock::now() >= next_idle_poll) idle_poll();
-      const auto deadline = monitoring ? std::min(next_heartbeat, next_poll)
-                                       : settings.idle_poll_period_s > 0 ? next_idle_poll
-                                                                         : Clock::now() + std::chrono::seconds(1);
+      const auto deadline = monitoring ? std::min(next_heartbeat, next_poll) : idle_deadline();
       std::unique_lock lock(mutex);
       wake.wait_until(lock, deadline,
                       [this] {
@@ -249,6 +253,35 @@ struct CellIo::Impl {
     return std::unexpected(std::move(error));
   }
 
+  Clock::time_point idle_deadline() const {
+    auto deadline = settings.idle_poll_period_s > 0 ? next_idle_poll : Clock::now() + std::chrono::seconds(1);
+    return beating ? std::min(deadline, next_heartbeat) : deadline;
+  }
+
+  // Heartbeats from the PLC's current value, so the first write is a change it counts.
+  Result start_beating() {
+    auto hb = client.read_registers(pm::kHoldHeartbeat, 1);
+    if (!hb) return std::unexpected(hb.error());
+    heartbeat_value = (*hb)[0];
+    if (auto r = beat_once(); !r) return r;
+    beating = true;
+    return {};
+  }
+
+  // A heartbeat alarm found at prepare says why it latched: how long laminad had been silent.
+  void say_why_heartbeat_alarm() const {
+    if (!snapshot().alarm_latched || snapshot().alarm_code != pm::kAlarmHeartbeat) return;
+    if (last_beat_at)
+      log->warn("PLC alarm {} ({}): laminad's heartbeat had been silent for {:.1f} s (the PLC was unreachable or "
+                "laminad stalled); resetting it",
+                pm::kAlarmHeartbeat, pm::alarm_name(pm::kAlarmHeartbeat),
+                std::chrono::duration<double>(Clock::now() - *last_beat_at).count());
+    else
+      log->warn("PLC alarm {} ({}): latched before this laminad beat (an earlier session ended or stalled); "
+                "resetting it",
+                pm::kAlarmHeartbeat, pm::alarm_name(pm::kAlarmHeartbeat));
+  }
+
   Result reset_alarm() {
     log->info("PLC alarm {} ({}) latched: pressing alarm_reset", snapshot().alarm_code, pm::alarm_name(snapshot().alarm_code));
     if (auto r = client.write_bit(pm::kCoilAlarmReset, true); !r) return r;
@@ -265,6 +298,10 @@ struct CellIo::Impl {
     auto s = snapshot();
     if (!s.estop_ok) return fail(interlock("cannot prepare the cut: e-stop pressed (estop_ok = 0)"));
     if (!s.door_closed) return fail(interlock("cannot prepare the cut: door open (door_closed = 0)"));
+    say_why_heartbeat_alarm();
+    // Beats first: the PLC clears a heartbeat alarm only once they come again.
+    if (!beating)
+      if (auto r = start_beating(); !r) return fail(r.error());
     // An alarm whose cause is gone (e.g. a released e-stop) would keep the pump off; clear it.
     if (s.alarm_latched)
       if (auto r = reset_alarm(); !r) return fail(r.error());
@@ -279,6 +316,8 @@ struct CellIo::Impl {
       if (!s.estop_ok) return fail(interlock("e-stop pressed while the pump started (estop_ok = 0)"));
       if (!s.door_closed) return fail(interlock("door opened while the pump started (door_closed = 0)"));
       if (s.pump_ready) break;
+      if (Clock::now() >= next_heartbeat)
+        if (auto r = beat_once(); !r) return fail(r.error());
       if (Clock::now() >= pump_deadline)
         return fail(interlock(fmt::format("pump not ready after {} s, pressure {:.1f} MPa of {:.1f} MPa",
                                           settings.pump_ready_timeout_s, s.pressure_mpa,
@@ -289,12 +328,8 @@ struct CellIo::Impl {
     if (auto r = client.write_register(pm::kHoldAbrasiveSetpoint, settings.abrasive_g_per_min); !r)
       return fail(r.error());
     if (auto r = client.write_bit(pm::kCoilAbrasiveEnable, true); !r) return fail(r.error());
-    // Heartbeat from the PLC's current value, so the first write is a change it counts.
-    auto hb = client.read_registers(pm::kHoldHeartbeat, 1);
-    if (!hb) return fail(hb.error());
-    heartbeat_value = (*hb)[0];
     if (auto r = beat_once(); !r) return fail(r.error());
-    // A heartbeat alarm from an earlier session clears now that heartbeats come again.
+    // A heartbeat alarm the first press could not clear clears now that heartbeats come again.
     if (auto r = read_inputs(); !r) return fail(r.error());
     if (snapshot().alarm_latched) {
       if (auto r = reset_alarm(); !r) return fail(r.error());
@@ -357,7 +392,7 @@ struct CellIo::Impl {
   }
 
   Result finish() {
-    monitoring = false;  // the heartbeat stops with it: the PLC's watchdog takes over
+    monitoring = false;  // polling and interlock faults stop with the cut; the heartbeat goes on
     Result first = {};
     for (int coil : {pm::kCoilJetOn, pm::kCoilAbrasiveEnable, pm::kCoilPumpEnable})
       if (auto r = client.write_bit(coil, false); !r && first) first = std::unexpected(r.error());
@@ -369,7 +404,17 @@ struct CellIo::Impl {
   Result beat_once() {
     heartbeat_value = static_cast<std::uint16_t>(heartbeat_value + 1);  // always a change
     next_heartbeat = Clock::now() + seconds(settings.heartbeat_period_s);
-    return client.write_register(pm::kHoldHeartbeat, heartbeat_value);
+    auto r = client.write_register(pm::kHoldHeartbeat, heartbeat_value);
+    if (r) last_beat_at = Clock::now();
+    return r;
+  }
+  // Between cuts no fault is raised (no cut to stop): the beat stops, said once, and starts
+  // again with the next cut; the PLC's watchdog latches meanwhile, and that cut says why.
+  void idle_beat() {
+    if (auto r = beat_once(); !r) {
+      beating = false;
+      log->warn("the heartbeat between cuts failed ({}); it starts again with the next cut", r.error().message);
+    }
   }
   void beat() {
     if (auto r = beat_once(); !r) link_lost(r.error());
@@ -398,6 +443,7 @@ struct CellIo::Impl {
 
   void link_lost(const LinkError& error) {
     monitoring = false;
+    beating = false;
     {
       std::lock_guard lock(mutex);
       status.connected = false;

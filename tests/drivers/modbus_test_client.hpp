@@ -26,6 +26,7 @@ namespace map {
 inline constexpr int kCoilPump = 0, kCoilAbrasive = 1, kCoilJet = 2;
 inline constexpr int kInputPumpReady = 2, kInputJetIsOn = 3, kInputAlarmLatched = 4;
 inline constexpr int kInAlarmCode = 6, kInCncState = 7;  // cnc_state: 0 idle, 1 run, 2 hold pending, 3 hold, 4 alarm
+inline constexpr int kHoldHeartbeat = 1;
 }  // namespace map
 
 struct ModbusCloser {

@@ -72,6 +72,25 @@ TEST(CellIo, HeartbeatKeepsTheWatchdogQuietAndItsSilenceTripsIt) {
   EXPECT_TRUE(eventually([&] { return plc.in_reg(map::kInAlarmCode) == 2; }, 2.0)) << "heartbeat alarm latched";
 }
 
+// Issue 18: the heartbeat stopped with every finished cut, so the PLC's watchdog latched its
+// alarm in each gap between sheets and the next prepare reset it without a word. It goes on
+// between cuts now: the register keeps changing after finish_cut (waited for, not slept on).
+TEST(CellIo, TheHeartbeatGoesOnBetweenCuts) {
+  SimCell cell;
+  PlcProbe plc(cell.sim.modbus_port());
+  CellIo io(settings_for(cell.sim.modbus_port()));
+  ASSERT_TRUE(io.prepare_cut());
+  ASSERT_TRUE(io.finish_cut());
+  for (int beat = 0; beat < 3; ++beat) {
+    const int before = plc.hold(map::kHoldHeartbeat);
+    EXPECT_TRUE(eventually([&] { return plc.hold(map::kHoldHeartbeat) != before; }, 5.0))
+        << "beat " << beat << " after the cut finished";
+  }
+  EXPECT_EQ(plc.coil(map::kCoilJet), 0) << "the jet stays off between cuts";
+  ASSERT_TRUE(io.prepare_cut()) << "the next sheet starts without an alarm to reset";
+  EXPECT_EQ(plc.input(map::kInputAlarmLatched), 0);
+}
+
 // One interlock fault while cutting: reported once, within two poll periods, jet consent removed.
 void expect_fault_while_cutting(const std::string& command, CellFault expected, const std::string& word) {
   SimCell cell;
