@@ -41,9 +41,14 @@ std::expected<int, RpcError> int_param(const Json& params, const char* key, int 
   return static_cast<int>(it->get<std::int64_t>());
 }
 
-RpcResult job_result(std::expected<JobRecord, RpcError> r) {
-  if (!r) return std::unexpected(r.error());
+RpcResult job_result(std::expected<JobRecord, JobError> r) {
+  if (!r) return std::unexpected(rpc_error(r.error()));
   return to_json(*r);
+}
+
+RpcResult machine_result(std::expected<Json, JobError> r) {
+  if (!r) return std::unexpected(rpc_error(r.error()));
+  return std::move(*r);
 }
 
 // upload.begin / chunk / cancel: a model sent in pieces (uploads.hpp).
@@ -83,6 +88,20 @@ void add_upload_methods(std::map<std::string, Method>& m, Uploads& uploads) {
 }
 
 }  // namespace
+
+RpcError rpc_error(const JobError& e) {
+  int code = rpc_code::internal_error;
+  switch (e.kind) {
+    case JobErrorKind::bad_request: code = rpc_code::invalid_params; break;
+    case JobErrorKind::not_found: code = rpc_code::job_not_found; break;
+    case JobErrorKind::wrong_state: code = rpc_code::invalid_state; break;
+    case JobErrorKind::machine_busy: code = rpc_code::machine_busy; break;
+    case JobErrorKind::storage: code = rpc_code::storage_error; break;
+    case JobErrorKind::shutting_down: code = rpc_code::shutting_down; break;
+    case JobErrorKind::internal: code = rpc_code::internal_error; break;
+  }
+  return RpcError{code, e.message, nullptr};
+}
 
 RpcServer::Handler make_api_handler(JobManager& jobs, Uploads& uploads, ServerInfo info) {
   auto methods = std::make_shared<std::map<std::string, Method>>();
@@ -134,7 +153,7 @@ RpcServer::Handler make_api_handler(JobManager& jobs, Uploads& uploads, ServerIn
                       {"sheets", j.sheets.size()}, {"error", j.error}, {"created_unix_ms", j.created_unix_ms}});
     return list;
   };
-  auto with_job = [&jobs](std::function<std::expected<JobRecord, RpcError>(const std::string&, const Json&)> f) {
+  auto with_job = [&jobs](std::function<std::expected<JobRecord, JobError>(const std::string&, const Json&)> f) {
     return [f](const Json& params, ClientContext&) -> RpcResult {
       auto p = object_params(params);
       if (!p) return std::unexpected(p.error());
@@ -146,18 +165,18 @@ RpcServer::Handler make_api_handler(JobManager& jobs, Uploads& uploads, ServerIn
   m["job.get"] = with_job([&jobs](const std::string& id, const Json&) { return jobs.get(id); });
   m["job.cancel"] = with_job([&jobs](const std::string& id, const Json&) { return jobs.cancel(id); });
   m["job.resume"] = with_job([&jobs](const std::string& id, const Json&) { return jobs.resume(id); });
-  m["job.confirm_sheet"] = with_job([&jobs](const std::string& id, const Json& params) -> std::expected<JobRecord, RpcError> {
+  m["job.confirm_sheet"] = with_job([&jobs](const std::string& id, const Json& params) -> std::expected<JobRecord, JobError> {
     auto sheet = int_param(params, "sheet", 1, 100000);
-    if (!sheet) return std::unexpected(sheet.error());
+    if (!sheet) return std::unexpected(job_error(JobErrorKind::bad_request, sheet.error().message));
     return jobs.confirm_sheet(id, *sheet);
   });
   m["machine.status"] = [&jobs](const Json&, ClientContext&) -> RpcResult { return jobs.machine_status(); };
-  m["machine.hold"] = [&jobs](const Json&, ClientContext&) -> RpcResult { return jobs.hold(); };
-  m["machine.resume"] = [&jobs](const Json&, ClientContext&) -> RpcResult { return jobs.resume_motion(); };
+  m["machine.hold"] = [&jobs](const Json&, ClientContext&) -> RpcResult { return machine_result(jobs.hold()); };
+  m["machine.resume"] = [&jobs](const Json&, ClientContext&) -> RpcResult { return machine_result(jobs.resume_motion()); };
   m["machine.abort"] = [&jobs](const Json& params, ClientContext&) -> RpcResult {
     std::string why = "aborted by the operator";
     if (params.is_object() && params.contains("reason") && params["reason"].is_string()) why = params["reason"];
-    return jobs.abort(why);
+    return machine_result(jobs.abort(why));
   };
 
   return [methods](const RpcRequest& request, ClientContext& client) -> RpcResult {

@@ -1,6 +1,7 @@
 #pragma once
-// The JSON-RPC methods of laminad (docs/api.md): parameter checking and the call into the
-// JobManager. Runs on the io thread; every method returns quickly.
+// The JSON-RPC methods of laminad (docs/api.md): parameter checking, the call into the
+// JobManager, and its errors mapped to JSON-RPC codes. Runs on the io thread; every method
+// returns quickly.
 #include <string>
 
 #include "job_manager.hpp"
@@ -16,5 +17,8 @@ struct ServerInfo {
 };
 
 RpcServer::Handler make_api_handler(JobManager& jobs, Uploads& uploads, ServerInfo info);
+
+// The one place the job domain's errors become JSON-RPC codes (docs/api.md's table).
+RpcError rpc_error(const JobError& e);
 
 }  // namespace lamina::daemon

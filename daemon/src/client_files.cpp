@@ -16,8 +16,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-RpcError invalid(std::string message) { return RpcError{rpc_code::invalid_params, std::move(message), nullptr}; }
-RpcError storage(std::string message) { return RpcError{rpc_code::storage_error, std::move(message), nullptr}; }
+JobError invalid(std::string message) { return JobError{JobErrorKind::bad_request, std::move(message)}; }
+JobError storage(std::string message) { return JobError{JobErrorKind::storage, std::move(message)}; }
 
 struct Fd {
   int fd = -1;
@@ -89,7 +89,7 @@ bool copy_bytes(int in, int out, std::uint64_t size) {
 
 // The opened, checked file: a regular file within the size limit, read through its own
 // descriptor (O_PATH first, so that opening a device or FIFO for reading never happens).
-std::expected<Fd, RpcError> open_checked(const std::string& path, std::string_view param, const ClientFileRules& rules,
+std::expected<Fd, JobError> open_checked(const std::string& path, std::string_view param, const ClientFileRules& rules,
                                          struct stat& st) {
   Fd handle(::open(path.c_str(), O_PATH | O_CLOEXEC));
   if (handle.fd < 0)
@@ -123,7 +123,7 @@ bool inside_roots(const fs::path& path, const std::vector<fs::path>& roots) {
   return false;
 }
 
-std::expected<fs::path, RpcError> import_client_file(const std::string& path, std::string_view param,
+std::expected<fs::path, JobError> import_client_file(const std::string& path, std::string_view param,
                                                      const ClientFileRules& rules, const fs::path& target_dir) {
   if (path.empty() || path.front() != '/')
     return std::unexpected(invalid(fmt::format("{}: expected an absolute path on the cell PC", param)));

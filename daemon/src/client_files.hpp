@@ -15,7 +15,7 @@
 #include <string_view>
 #include <vector>
 
-#include "lamina/daemon/rpc_server.hpp"
+#include "job_error.hpp"
 
 namespace lamina::daemon {
 
@@ -26,7 +26,7 @@ struct ClientFileRules {
 
 // `param` names the parameter in messages ("model", "settings.stock_file"). Blocking file I/O.
 // Returns the copy's path: target_dir / the file's name.
-std::expected<std::filesystem::path, RpcError> import_client_file(const std::string& path, std::string_view param,
+std::expected<std::filesystem::path, JobError> import_client_file(const std::string& path, std::string_view param,
                                                                   const ClientFileRules& rules,
                                                                   const std::filesystem::path& target_dir);
 

@@ -67,17 +67,17 @@ JobManager::ProgramRead JobManager::read_current_program(const std::string& job_
 // Under mutex_. Joins the previous cutting thread (it has left finish_cut: cutting_ is false).
 // Nothing moves unless the database has taken the job's `cutting` first: a cut it does not know
 // of would be cut again after a crash.
-std::expected<void, RpcError> JobManager::start_cut(JobRecord& job, CutStart how, const ProgramRead& read) {
+std::expected<void, JobError> JobManager::start_cut(JobRecord& job, CutStart how, const ProgramRead& read) {
   if (cutter_.joinable()) cutter_.join();
   SheetRecord* sheet = sheet_of(job, job.current_sheet);
-  if (!sheet) return std::unexpected(RpcError{rpc_code::internal_error, fmt::format("job {} has no sheet {}", job.id, job.current_sheet), nullptr});
+  if (!sheet) return std::unexpected(JobError{JobErrorKind::internal, fmt::format("job {} has no sheet {}", job.id, job.current_sheet)});
   // Read before the lock was taken (a long program must not hold up the operator's hold); again
   // here only if the sheet changed meanwhile.
   std::vector<std::string> program = read.path == sheet->program_path ? read.lines : read_program(sheet->program_path);
   if (program.empty()) {
     const std::string why = fmt::format("{}: no program lines", sheet->program_path);
     (void)set_state(job, JobState::interrupted, why);
-    return std::unexpected(RpcError{rpc_code::invalid_state, why, nullptr});
+    return std::unexpected(JobError{JobErrorKind::wrong_state, why});
   }
   const SheetState sheet_before = sheet->state;
   sheet->state = SheetState::cutting;

@@ -32,7 +32,6 @@ std::string new_job_id() {
   return fmt::format("j-{}-{:04x}", now_unix_ms(), rng() & 0xFFFF);
 }
 
-RpcError error(int code, std::string message) { return RpcError{code, std::move(message), nullptr}; }
 
 std::shared_ptr<spdlog::logger> log() {
   static auto logger = [] {
@@ -69,9 +68,9 @@ JobManager::JobManager(const DaemonConfig& config, JobStore& store, MachineSessi
 
 JobManager::~JobManager() { shutdown("daemon stopping"); }
 
-std::expected<void, RpcError> JobManager::start() {
+std::expected<void, JobError> JobManager::start() {
   auto all = store_.list_jobs();
-  if (!all) return std::unexpected(error(rpc_code::storage_error, all.error().message));
+  if (!all) return std::unexpected(job_error(JobErrorKind::storage, all.error().message));
   std::lock_guard lock(mutex_);
   for (JobRecord& job : *all) {
     if (job.state == JobState::queued) plan_queue_.push_back(job.id);
@@ -112,13 +111,13 @@ void JobManager::shutdown(const std::string& why) {
 
 // Disk first, memory after: a state the database did not take is not taken at all (the job is
 // read back as the database has it), so what clients are told never runs ahead of a restart.
-std::expected<void, RpcError> JobManager::set_state(JobRecord& job, JobState to, const std::string& why) {
+std::expected<void, JobError> JobManager::set_state(JobRecord& job, JobState to, const std::string& why) {
   if (auto refused = store_refusal()) {
     reload(job);
     return std::unexpected(*refused);
   }
   if (!allowed(job.state, to))
-    return std::unexpected(error(rpc_code::invalid_state, fmt::format("job {} is {}: it cannot become {}", job.id,
+    return std::unexpected(job_error(JobErrorKind::wrong_state, fmt::format("job {} is {}: it cannot become {}", job.id,
                                                                       to_string(job.state), to_string(to))));
   const JobState from = job.state;
   JobRecord next = job;
@@ -153,9 +152,9 @@ void JobManager::store_failed(const std::string& message) {
   if (notify_) notify_("notify_machine_status", {{"store", {{"ok", false}, {"error", message}}}});
 }
 
-std::optional<RpcError> JobManager::store_refusal() const {
+std::optional<JobError> JobManager::store_refusal() const {
   if (!store_fault_) return std::nullopt;
-  return error(rpc_code::storage_error,
+  return job_error(JobErrorKind::storage,
                fmt::format("the job store cannot be written ({}): nothing was changed; free space under {} and "
                            "restart laminad",
                            *store_fault_, config_.state_dir.string()));
@@ -202,7 +201,7 @@ void JobManager::assign_machine() {
 // file named by path is checked against the roots and copied (client_files.hpp), and so is a
 // stock file. jobs/<id>/input/, apart from what the planner writes (a model named stack.stl
 // would otherwise be overwritten by the plan's own).
-std::expected<void, RpcError> JobManager::stage_inputs(JobRecord& job, const SubmitRequest& r) const {
+std::expected<void, JobError> JobManager::stage_inputs(JobRecord& job, const SubmitRequest& r) const {
   const fs::path input = fs::path(job.artefact_dir) / "input";
   std::vector<fs::path> roots(config_.jobs.roots.begin(), config_.jobs.roots.end());
   if (r.move_into_job) {
@@ -211,7 +210,7 @@ std::expected<void, RpcError> JobManager::stage_inputs(JobRecord& job, const Sub
     const std::string stored = fs::path(r.model_path).filename().string();  // "<upload id>-<name>"
     const fs::path target = input / stored.substr(stored.find('-') + 1);
     fs::rename(r.model_path, target, ec);
-    if (ec) return std::unexpected(error(rpc_code::storage_error, fmt::format("{}: {}", target.string(), ec.message())));
+    if (ec) return std::unexpected(job_error(JobErrorKind::storage, fmt::format("{}: {}", target.string(), ec.message())));
     job.model_path = target.string();
   } else {
     auto copy = import_client_file(r.model_path, "model", {roots, config_.jobs.max_model_bytes}, input);
@@ -227,15 +226,15 @@ std::expected<void, RpcError> JobManager::stage_inputs(JobRecord& job, const Sub
   return {};
 }
 
-std::expected<JobRecord, RpcError> JobManager::submit(SubmitRequest r) {
+std::expected<JobRecord, JobError> JobManager::submit(SubmitRequest r) {
   std::error_code ec;
-  auto fail = [&](RpcError e, const JobRecord* job) -> std::expected<JobRecord, RpcError> {
+  auto fail = [&](JobError e, const JobRecord* job) -> std::expected<JobRecord, JobError> {
     if (r.move_into_job) fs::remove(r.model_path, ec);  // a refused upload is not kept
     if (job) fs::remove_all(job->artefact_dir, ec);
     return std::unexpected(std::move(e));
   };
   auto args = plan_args_from_settings(r.settings);
-  if (!args) return fail(error(rpc_code::invalid_params, args.error()), nullptr);
+  if (!args) return fail(job_error(JobErrorKind::bad_request, args.error()), nullptr);
   {
     std::lock_guard lock(mutex_);
     if (auto refused = store_refusal()) return fail(*refused, nullptr);
@@ -255,7 +254,7 @@ std::expected<JobRecord, RpcError> JobManager::submit(SubmitRequest r) {
   if (auto staged = stage_inputs(job, r); !staged) return fail(staged.error(), &job);
 
   std::lock_guard lock(mutex_);
-  if (stopping_) return fail(error(rpc_code::shutting_down, "the daemon is stopping"), &job);
+  if (stopping_) return fail(job_error(JobErrorKind::shutting_down, "the daemon is stopping"), &job);
   if (auto s = store_.insert_job(job); !s) {
     store_failed(s.error().message);
     return fail(*store_refusal(), &job);
@@ -280,23 +279,23 @@ std::vector<JobRecord> JobManager::list() const {
   return out;
 }
 
-std::expected<JobRecord, RpcError> JobManager::get(const std::string& id) const {
+std::expected<JobRecord, JobError> JobManager::get(const std::string& id) const {
   std::lock_guard lock(mutex_);
   const JobRecord* job = find(id);
-  if (!job) return std::unexpected(error(rpc_code::job_not_found, fmt::format("no job {}", id)));
+  if (!job) return std::unexpected(job_error(JobErrorKind::not_found, fmt::format("no job {}", id)));
   return *job;
 }
 
-std::expected<JobRecord, RpcError> JobManager::cancel(const std::string& id) {
+std::expected<JobRecord, JobError> JobManager::cancel(const std::string& id) {
   std::shared_ptr<drivers::CutJob> cut;
   JobRecord copy;
   {
     std::lock_guard lock(mutex_);
     JobRecord* job = find(id);
-    if (!job) return std::unexpected(error(rpc_code::job_not_found, fmt::format("no job {}", id)));
+    if (!job) return std::unexpected(job_error(JobErrorKind::not_found, fmt::format("no job {}", id)));
     if (auto refused = store_refusal()) return std::unexpected(*refused);  // machine.abort stops a cut all the same
     if (is_terminal(job->state))
-      return std::unexpected(error(rpc_code::invalid_state, fmt::format("job {} is already {}", id, to_string(job->state))));
+      return std::unexpected(job_error(JobErrorKind::wrong_state, fmt::format("job {} is already {}", id, to_string(job->state))));
     if (job->state == JobState::planning) {
       if (auto it = plan_cancel_.find(id); it != plan_cancel_.end()) it->second->store(true);
       return *job;  // the planner worker marks it cancelled when the child has stopped
@@ -329,26 +328,26 @@ std::expected<JobRecord, RpcError> JobManager::cancel(const std::string& id) {
   return copy;
 }
 
-std::expected<JobRecord, RpcError> JobManager::confirm_sheet(const std::string& id, int sheet) {
+std::expected<JobRecord, JobError> JobManager::confirm_sheet(const std::string& id, int sheet) {
   const ProgramRead program = read_current_program(id);
   std::lock_guard lock(mutex_);
   JobRecord* job = find(id);
-  if (!job) return std::unexpected(error(rpc_code::job_not_found, fmt::format("no job {}", id)));
+  if (!job) return std::unexpected(job_error(JobErrorKind::not_found, fmt::format("no job {}", id)));
   if (job->state != JobState::waiting_sheet)
-    return std::unexpected(error(rpc_code::invalid_state,
+    return std::unexpected(job_error(JobErrorKind::wrong_state,
                                  fmt::format("job {} is {}, not waiting for a sheet", id, to_string(job->state))));
   if (sheet != job->current_sheet)
-    return std::unexpected(error(rpc_code::invalid_params,
+    return std::unexpected(job_error(JobErrorKind::bad_request,
                                  fmt::format("sheet {}: job {} waits for sheet {}", sheet, id, job->current_sheet)));
   if (auto started = start_cut(*job, CutStart::fresh, program); !started) return std::unexpected(started.error());
   return *job;
 }
 
-std::expected<JobRecord, RpcError> JobManager::resume(const std::string& id) {
+std::expected<JobRecord, JobError> JobManager::resume(const std::string& id) {
   const ProgramRead program = read_current_program(id);
   std::lock_guard lock(mutex_);
   JobRecord* job = find(id);
-  if (!job) return std::unexpected(error(rpc_code::job_not_found, fmt::format("no job {}", id)));
+  if (!job) return std::unexpected(job_error(JobErrorKind::not_found, fmt::format("no job {}", id)));
   if (auto refused = store_refusal()) return std::unexpected(*refused);
   if (job->state == JobState::paused && pause_ == PauseKind::hold && cutting_) {
     std::shared_ptr<drivers::CutJob> cut = cut_;
@@ -358,18 +357,18 @@ std::expected<JobRecord, RpcError> JobManager::resume(const std::string& id) {
     return *job;
   }
   if (job->state == JobState::paused) {
-    if (cutting_) return std::unexpected(error(rpc_code::machine_busy, "the cut is still stopping; try again"));
+    if (cutting_) return std::unexpected(job_error(JobErrorKind::machine_busy, "the cut is still stopping; try again"));
     if (auto started = start_cut(*job, CutStart::resume_stopped, program); !started) return std::unexpected(started.error());
     return *job;
   }
   if (job->state == JobState::interrupted) {
     if (!machine_job_.empty() && machine_job_ != id)
-      return std::unexpected(error(rpc_code::machine_busy, fmt::format("the machine is with job {}", machine_job_)));
+      return std::unexpected(job_error(JobErrorKind::machine_busy, fmt::format("the machine is with job {}", machine_job_)));
     if (auto started = start_cut(*job, CutStart::resume_interrupted, program); !started) return std::unexpected(started.error());
     machine_job_ = id;
     return *job;
   }
-  return std::unexpected(error(rpc_code::invalid_state,
+  return std::unexpected(job_error(JobErrorKind::wrong_state,
                                fmt::format("job {} is {}: only paused or interrupted jobs resume", id, to_string(job->state))));
 }
 
@@ -391,13 +390,13 @@ nlohmann::json JobManager::machine_status() {
 
 // The machine first, the bookkeeping after: the hold reaches the line and the PLC without
 // waiting for the database (a synced write) or for anyone holding the lock.
-std::expected<nlohmann::json, RpcError> JobManager::hold() {
+std::expected<nlohmann::json, JobError> JobManager::hold() {
   std::shared_ptr<drivers::CutJob> cut;
   {
     std::lock_guard lock(mutex_);
     JobRecord* job = find(machine_job_);
     if (!job || job->state != JobState::cutting || !cutting_)
-      return std::unexpected(error(rpc_code::invalid_state, "nothing is cutting"));
+      return std::unexpected(job_error(JobErrorKind::wrong_state, "nothing is cutting"));
     cut = cut_;
   }
   cut->hold();  // the line's real-time byte and the PLC's button (a drip feed has no hold on its line)
@@ -409,23 +408,23 @@ std::expected<nlohmann::json, RpcError> JobManager::hold() {
   return nlohmann::json{{"held", true}};
 }
 
-std::expected<nlohmann::json, RpcError> JobManager::resume_motion() {
+std::expected<nlohmann::json, JobError> JobManager::resume_motion() {
   std::string id;
   {
     std::lock_guard lock(mutex_);
     id = machine_job_;
   }
-  if (id.empty()) return std::unexpected(error(rpc_code::invalid_state, "no job has the machine"));
+  if (id.empty()) return std::unexpected(job_error(JobErrorKind::wrong_state, "no job has the machine"));
   auto r = resume(id);
   if (!r) return std::unexpected(r.error());
   return to_json(*r);
 }
 
-std::expected<nlohmann::json, RpcError> JobManager::abort(const std::string& why) {
+std::expected<nlohmann::json, JobError> JobManager::abort(const std::string& why) {
   std::shared_ptr<drivers::CutJob> cut;
   {
     std::lock_guard lock(mutex_);
-    if (!cutting_) return std::unexpected(error(rpc_code::invalid_state, "nothing is cutting"));
+    if (!cutting_) return std::unexpected(job_error(JobErrorKind::wrong_state, "nothing is cutting"));
     cut = cut_;
   }
   cut->abort(why);  // the cut stops safely; its job becomes paused with a resume point

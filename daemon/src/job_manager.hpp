@@ -22,7 +22,7 @@
 #include "lamina/daemon/daemon_config.hpp"
 #include "lamina/daemon/job_model.hpp"
 #include "lamina/daemon/job_store.hpp"
-#include "lamina/daemon/rpc_server.hpp"
+#include "job_error.hpp"
 #include "lamina/drivers/cut_job.hpp"
 #include "machine_session.hpp"
 
@@ -46,21 +46,21 @@ class JobManager {
   JobManager& operator=(const JobManager&) = delete;
 
   // Loads the jobs (after JobStore::recover_after_restart), starts the planner workers.
-  std::expected<void, RpcError> start();
+  std::expected<void, JobError> start();
   // SIGTERM: stop planning, stop the cut safely (its job becomes interrupted), wait for threads.
   void shutdown(const std::string& why);
 
-  std::expected<JobRecord, RpcError> submit(SubmitRequest request);
+  std::expected<JobRecord, JobError> submit(SubmitRequest request);
   std::vector<JobRecord> list() const;
-  std::expected<JobRecord, RpcError> get(const std::string& id) const;
-  std::expected<JobRecord, RpcError> cancel(const std::string& id);
-  std::expected<JobRecord, RpcError> confirm_sheet(const std::string& id, int sheet);
-  std::expected<JobRecord, RpcError> resume(const std::string& id);  // paused or interrupted
+  std::expected<JobRecord, JobError> get(const std::string& id) const;
+  std::expected<JobRecord, JobError> cancel(const std::string& id);
+  std::expected<JobRecord, JobError> confirm_sheet(const std::string& id, int sheet);
+  std::expected<JobRecord, JobError> resume(const std::string& id);  // paused or interrupted
 
   nlohmann::json machine_status();  // checks the database file too
-  std::expected<nlohmann::json, RpcError> hold();
-  std::expected<nlohmann::json, RpcError> resume_motion();
-  std::expected<nlohmann::json, RpcError> abort(const std::string& why);
+  std::expected<nlohmann::json, JobError> hold();
+  std::expected<nlohmann::json, JobError> resume_motion();
+  std::expected<nlohmann::json, JobError> abort(const std::string& why);
 
   std::string status_line() const;  // for sd_notify STATUS=
 
@@ -69,9 +69,9 @@ class JobManager {
   enum class PauseKind { none, hold, stopped };
 
   // --- under mutex_ ---
-  std::expected<void, RpcError> set_state(JobRecord& job, JobState to, const std::string& why = {});
+  std::expected<void, JobError> set_state(JobRecord& job, JobState to, const std::string& why = {});
   void store_failed(const std::string& message);     // latches the fault, stops the cut
-  std::optional<RpcError> store_refusal() const;      // -32014 while the store has failed
+  std::optional<JobError> store_refusal() const;      // -32014 while the store has failed
   void reload(JobRecord& job);                        // memory as the database has it
   void event(const JobRecord& job, const std::string& kind, nlohmann::json data);
   void announce(const JobRecord& job);
@@ -84,8 +84,8 @@ class JobManager {
   };
   static std::vector<std::string> read_program(const std::string& path);
   ProgramRead read_current_program(const std::string& job_id) const;  // takes the lock briefly
-  std::expected<void, RpcError> start_cut(JobRecord& job, CutStart how, const ProgramRead& read);
-  std::expected<void, RpcError> stage_inputs(JobRecord& job, const SubmitRequest& r) const;  // no lock needed
+  std::expected<void, JobError> start_cut(JobRecord& job, CutStart how, const ProgramRead& read);
+  std::expected<void, JobError> stage_inputs(JobRecord& job, const SubmitRequest& r) const;  // no lock needed
 
   // --- threads ---
   void planner_loop();

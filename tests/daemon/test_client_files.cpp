@@ -29,7 +29,7 @@ struct Folders {
     rules.roots = {parts};
     rules.max_bytes = 1000;
   }
-  std::expected<fs::path, RpcError> import(const std::string& path) const {
+  std::expected<fs::path, JobError> import(const std::string& path) const {
     return import_client_file(path, "model", rules, job);
   }
 };
@@ -60,7 +60,7 @@ TEST(ClientFiles, APathOutsideTheRootsIsRefusedWithoutTellingWhetherItExists) {
   ASSERT_FALSE(a);
   ASSERT_FALSE(b);
   ASSERT_FALSE(shadow);
-  EXPECT_EQ(a.error().code, rpc_code::invalid_params);
+  EXPECT_EQ(a.error().kind, JobErrorKind::bad_request);
   EXPECT_NE(a.error().message.find("outside the folders"), std::string::npos) << a.error().message;
   std::string b_as_a = b.error().message;
   b_as_a.replace(b_as_a.find(missing), missing.size(), secret);
