@@ -90,6 +90,8 @@ std::expected<PostedProgram, Error> post_program(const SheetToolpath& toolpath, 
 
   PostedProgram out;
   out.contour_lines.assign(toolpath.contours.size(), 0);
+  out.contour_last_cut_lines.assign(toolpath.contours.size(), 0);
+  std::optional<std::size_t> contour;  // the contour whose marker came last
   Writer w;
   for (const std::string& line : post_detail::program_start(head, params)) w.emit(line);
 
@@ -104,6 +106,7 @@ std::expected<PostedProgram, Error> post_program(const SheetToolpath& toolpath, 
   auto motion_line = [&](const std::string& line, bool five_axis) {
     w.emit(line);
     ++out.motion_lines;
+    if (jet && contour) out.contour_last_cut_lines[*contour] = w.lines;
     if (five_axis) {
       ++out.five_axis_moves;
       out.five_axis_bytes += line.size() + 1;
@@ -114,8 +117,10 @@ std::expected<PostedProgram, Error> post_program(const SheetToolpath& toolpath, 
     const ToolMove& m = moves[i];
     const AxisPose& p = poses[i];
     for (auto [it, end] = contour_at.equal_range(i); it != end; ++it) {
+      if (!contour) out.setup_lines = w.lines;
       w.emit(contour_marker(it->second, toolpath.contours[it->second]));
       out.contour_lines[it->second] = w.lines;
+      contour = it->second;
       // The program can be resumed at the marker: the next lines restate the modal words.
       force = true;
       motion = Motion::none;

@@ -2,6 +2,7 @@
 // (drivers::CutJob), saves its progress (the crash-safe record of where it is) and turns the
 // outcome into the job's next state.
 #include <chrono>
+#include <filesystem>
 #include <fstream>
 #include <thread>
 
@@ -44,6 +45,31 @@ SheetRecord* sheet_of(JobRecord& job, int index) {
   return nullptr;
 }
 
+// The sheet's program map as the post handed it over (report.json's contour_lines: issue 18), for
+// the resume point. The program must still be the one planned: its line count is checked.
+std::expected<drivers::ProgramMap, std::string> program_map_of(const std::string& artefact_dir, int sheet_index,
+                                                               std::size_t program_lines) {
+  const std::string path = (std::filesystem::path(artefact_dir) / "report.json").string();
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return std::unexpected(fmt::format("{}: cannot read the plan's report", path));
+  auto report = parse_plan_report(std::string{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()});
+  if (!report) return std::unexpected(report.error().message);
+  for (const ReportSheet& s : report->sheets.value_or(std::vector<ReportSheet>{})) {
+    if (s.index != sheet_index) continue;
+    if (s.program_lines != static_cast<std::int64_t>(program_lines))
+      return std::unexpected(fmt::format("{} has {} lines, the plan made {}: it changed since it was planned", s.program,
+                                         program_lines, s.program_lines));
+    drivers::ProgramMap map;
+    map.setup_end = static_cast<std::size_t>(s.setup_lines);
+    for (const ReportContour& c : s.contour_lines)
+      map.contours.push_back({static_cast<int>(c.index), static_cast<std::size_t>(c.line - 1),
+                              c.last_cut_line > 0 ? std::optional(static_cast<std::size_t>(c.last_cut_line - 1))
+                                                  : std::nullopt});
+    return map;
+  }
+  return std::unexpected(fmt::format("{}: no sheet {}", path, sheet_index));
+}
+
 bool still(drivers::ControllerState s) {
   using S = drivers::ControllerState;
   return s == S::idle || s == S::hold || s == S::alarm || s == S::door;
@@ -53,14 +79,19 @@ bool still(drivers::ControllerState s) {
 
 JobManager::ProgramRead JobManager::read_current_program(const std::string& job_id) const {
   ProgramRead read;
+  std::string artefact_dir;
+  int sheet = 0;
   {
     std::lock_guard lock(mutex_);
     const JobRecord* job = find(job_id);
     if (!job) return read;
     for (const SheetRecord& s : job->sheets)
-      if (s.index == job->current_sheet) read.path = s.program_path;
+      if (s.index == job->current_sheet) read.path = s.program_path, sheet = s.index;
+    artefact_dir = job->artefact_dir;
   }
-  if (!read.path.empty()) read.lines = read_program(read.path);
+  if (read.path.empty()) return read;
+  read.lines = read_program(read.path);
+  read.map = program_map_of(artefact_dir, sheet, read.lines.size());
   return read;
 }
 
@@ -73,11 +104,17 @@ std::expected<void, JobError> JobManager::start_cut(JobRecord& job, CutStart how
   if (!sheet) return std::unexpected(JobError{JobErrorKind::internal, fmt::format("job {} has no sheet {}", job.id, job.current_sheet)});
   // Read before the lock was taken (a long program must not hold up the operator's hold); again
   // here only if the sheet changed meanwhile.
-  std::vector<std::string> program = read.path == sheet->program_path ? read.lines : read_program(sheet->program_path);
+  const bool same = read.path == sheet->program_path;
+  std::vector<std::string> program = same ? read.lines : read_program(sheet->program_path);
   if (program.empty()) {
     const std::string why = fmt::format("{}: no program lines", sheet->program_path);
     (void)set_state(job, JobState::interrupted, why);
     return std::unexpected(JobError{JobErrorKind::wrong_state, why});
+  }
+  auto map = same ? read.map : program_map_of(job.artefact_dir, sheet->index, program.size());
+  if (!map) {  // no safe resume point could be known: nothing is cut
+    (void)set_state(job, JobState::interrupted, map.error());
+    return std::unexpected(JobError{JobErrorKind::wrong_state, map.error()});
   }
   const SheetState sheet_before = sheet->state;
   sheet->state = SheetState::cutting;
@@ -86,8 +123,11 @@ std::expected<void, JobError> JobManager::start_cut(JobRecord& job, CutStart how
     return std::unexpected(written.error());
   }
   sheet = sheet_of(job, job.current_sheet);
-  if (how != CutStart::resume_stopped || !cut_)
-    cut_ = std::make_shared<drivers::CutJob>(machine_.link(), machine_.cell(), program, machine_.cut_settings());
+  if (how != CutStart::resume_stopped || !cut_) {
+    drivers::CutJobSettings settings = machine_.cut_settings();
+    settings.program_map = std::move(*map);
+    cut_ = std::make_shared<drivers::CutJob>(machine_.link(), machine_.cell(), program, std::move(settings));
+  }
   if (how == CutStart::resume_stopped && cut_->report().state != drivers::CutState::stopped) how = CutStart::fresh;
   cutting_ = true;
   pause_ = PauseKind::none;

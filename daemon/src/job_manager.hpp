@@ -81,6 +81,8 @@ class JobManager {
   struct ProgramRead {
     std::string path;
     std::vector<std::string> lines;
+    // Where its contours are, as the post made it (report.json), checked against `lines`.
+    std::expected<drivers::ProgramMap, std::string> map = std::unexpected(std::string("not read"));
   };
   static std::vector<std::string> read_program(const std::string& path);
   ProgramRead read_current_program(const std::string& job_id) const;  // takes the lock briefly

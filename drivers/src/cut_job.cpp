@@ -35,8 +35,9 @@ const char* to_string(CutState state) {
 }
 
 CutJob::CutJob(MachineLink& link, CellIo* cell, std::vector<std::string> program, CutJobSettings settings)
-    : link_(link), cell_(cell), program_(std::move(program)), settings_(settings) {
+    : link_(link), cell_(cell), program_(std::move(program)), settings_(std::move(settings)) {
   report_.lines_total = program_.size();
+  map_ = settings_.program_map ? *settings_.program_map : program_map_from_markers(program_);
 }
 
 CutJob::~CutJob() {
@@ -108,7 +109,7 @@ CutReport CutJob::resume_from(std::size_t first_unfinished_line) {
   {
     std::lock_guard lock(mutex_);
     report_.first_unfinished_line = std::min(first_unfinished_line, program_.size());
-    auto plan = plan_resume(program_, report_.first_unfinished_line, settings_.safe_z_mm);
+    auto plan = plan_resume(program_, map_, report_.first_unfinished_line, settings_.safe_z_mm);
     if (!plan) {
       report_.state = CutState::failed;
       report_.reason = plan.error();
@@ -362,7 +363,7 @@ void CutJob::stop_safely(LinkError why) {
     if (const auto cell_fault = cell_->fault()) report_.reason->message += " (cell: " + cell_fault->message + ")";
   if (reset_failed) report_.reason->message += "; " + reset_failed->message;
   report_.last_status = still ? still : report_.last_status;
-  if (auto plan = plan_resume(program_, report_.first_unfinished_line, settings_.safe_z_mm)) {
+  if (auto plan = plan_resume(program_, map_, report_.first_unfinished_line, settings_.safe_z_mm)) {
     report_.resume = *plan;
   } else {
     report_.resume.reset();

@@ -1,5 +1,6 @@
 #include "lamina/drivers/resume_point.hpp"
 
+#include <algorithm>
 #include <cctype>
 #include <charconv>
 #include <optional>
@@ -73,20 +74,20 @@ bool has_axis_word(const std::string& words) {
   return words.find_first_of("XYZAC") != std::string::npos;
 }
 
-// Whether contour lines [first_unfinished, end) hold no cut: the jet M-code (from the contour's
-// start on) is off for every move left, so all that remains is its jet-off and retract.
-bool cut_finished(const std::vector<std::string>& program, std::size_t contour_start, std::size_t first_unfinished,
-                  std::size_t end) {
+// The last line of [start, end) that moves with the jet M-code on (M3/M4 … M5), not a dwell.
+std::optional<std::size_t> last_cut_by_m_codes(const std::vector<std::string>& program, std::size_t start,
+                                               std::size_t end) {
   bool jet = false;
-  for (std::size_t i = contour_start; i < end; ++i) {
+  std::optional<std::size_t> last;
+  for (std::size_t i = start; i < end; ++i) {
     const std::string words = words_of(program[i]);
     if (const auto m = word_value(words, 'M')) {
       if (*m == 3 || *m == 4) jet = true;
       if (*m == 5) jet = false;
     }
-    if (i >= first_unfinished && jet && has_axis_word(words) && !has_g(words, 4)) return false;
+    if (jet && has_axis_word(words) && !has_g(words, 4)) last = i;
   }
-  return true;
+  return last;
 }
 
 }  // namespace
@@ -110,45 +111,53 @@ std::size_t first_unfinished_line(const std::vector<std::string>& program, std::
   return first;
 }
 
-std::expected<ResumePlan, LinkError> plan_resume(const std::vector<std::string>& program, std::size_t first_unfinished,
-                                                 double safe_z_mm) {
+ProgramMap program_map_from_markers(const std::vector<std::string>& program) {
+  ProgramMap map;
+  map.setup_end = program.size();
+  for (std::size_t i = 0; i < program.size(); ++i)
+    if (const auto n = contour_marker(program[i])) {
+      map.setup_end = std::min(map.setup_end, i);
+      map.contours.push_back({*n, i, std::nullopt});
+    }
+  for (std::size_t c = 0; c < map.contours.size(); ++c) {
+    const std::size_t end = c + 1 < map.contours.size() ? map.contours[c + 1].start_index : program.size();
+    map.contours[c].last_cut_index = last_cut_by_m_codes(program, map.contours[c].start_index, end);
+  }
+  return map;
+}
+
+std::expected<ResumePlan, LinkError> plan_resume(const std::vector<std::string>& program, const ProgramMap& map,
+                                                 std::size_t first_unfinished, double safe_z_mm) {
   if (first_unfinished > program.size())
     return std::unexpected(LinkError{LinkErrorCode::bad_request,
                                      fmt::format("resume at line {} of a {}-line program", first_unfinished + 1,
                                                  program.size())});
-  ResumePlan plan;
-  std::size_t first_marker = program.size();
-  for (std::size_t i = 0; i < program.size(); ++i) {
-    const auto n = contour_marker(program[i]);
-    if (!n) continue;
-    first_marker = std::min(first_marker, i);
-    if (i <= first_unfinished) {
-      plan.restart_index = i;
-      plan.contour = *n;
-    }
-  }
-  if (first_marker == program.size() && first_unfinished > 0)
+  if (map.contours.empty() && first_unfinished > 0)
     return std::unexpected(LinkError{LinkErrorCode::bad_request,
-                                     "the program carries no (CONTOUR …) markers: no safe point to resume from"});
-  if (plan.contour < 0) return plan;  // nothing of a contour ran yet: start over from the top
+                                     "the program has no contours marked (no map from its plan, no (CONTOUR n …) "
+                                     "markers): no safe point to resume from"});
+  ResumePlan plan;
+  std::size_t at = map.contours.size();  // the contour the first unfinished line is in
+  for (std::size_t c = 0; c < map.contours.size(); ++c)
+    if (map.contours[c].start_index <= first_unfinished) at = c;
+  if (at == map.contours.size()) return plan;  // nothing of a contour ran yet: start over from the top
+  plan.restart_index = map.contours[at].start_index;
+  plan.contour = map.contours[at].contour;
   // A contour whose cutting moves have all run is finished even if its jet-off and retract have
   // not: restarting it would cut it twice (the fault campaign: a pressure drop on contour 27's
   // last line). The resume goes on at the next contour, or after the cut if it was the last.
-  std::size_t next_marker = program.size();
-  for (std::size_t i = plan.restart_index + 1; i < program.size() && next_marker == program.size(); ++i)
-    if (contour_marker(program[i])) next_marker = i;
-  if (first_unfinished > plan.restart_index &&
-      cut_finished(program, plan.restart_index, first_unfinished, next_marker)) {
-    if (next_marker < program.size()) {
-      plan.restart_index = next_marker;
-      plan.contour = *contour_marker(program[next_marker]);
+  const auto& last_cut = map.contours[at].last_cut_index;
+  if (first_unfinished > plan.restart_index && (!last_cut || *last_cut < first_unfinished)) {
+    if (at + 1 < map.contours.size()) {
+      plan.restart_index = map.contours[at + 1].start_index;
+      plan.contour = map.contours[at + 1].contour;
     } else {
       plan.restart_index = first_unfinished;
     }
   }
   // The set-up the program makes before its first contour, minus motion: units, distance and
   // feed modes. Then inverse time off (the contour may have ended in G93) and a retract.
-  for (std::size_t i = 0; i < first_marker; ++i) {
+  for (std::size_t i = 0; i < std::min(map.setup_end, program.size()); ++i) {
     const std::string words = words_of(program[i]);
     if (!words.empty() && !has_axis_word(words) && words.front() != '%' && words.front() != 'O')
       plan.preamble.push_back(program[i]);

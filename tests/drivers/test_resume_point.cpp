@@ -1,4 +1,5 @@
-// Resume points from the program text and the controller's planner occupancy.
+// Resume points from the program, its map (the post's, or its markers') and the controller's
+// planner occupancy.
 #include <gtest/gtest.h>
 
 #include "lamina/drivers/resume_point.hpp"
@@ -30,6 +31,10 @@ const std::vector<std::string> kProgram{
     "M30",                                         // 20
 };
 
+std::expected<ResumePlan, LinkError> resume_at(const std::vector<std::string>& program, std::size_t line) {
+  return plan_resume(program, program_map_from_markers(program), line);
+}
+
 TEST(ResumePoint, PlannerBlocksAreMotionAndDwellLinesOnly) {
   EXPECT_TRUE(takes_planner_block("G0X1"));
   EXPECT_TRUE(takes_planner_block("Z0"));
@@ -55,38 +60,85 @@ TEST(ResumePoint, FirstUnfinishedLineWalksBackOverQueuedBlocks) {
 }
 
 TEST(ResumePoint, RestartsAtTheContourMarkerWithSetUpAndRetract) {
-  const auto plan = plan_resume(kProgram, 16);
+  const auto plan = resume_at(kProgram, 16);
   ASSERT_TRUE(plan) << plan.error().message;
   EXPECT_EQ(plan->restart_index, 12u);
   EXPECT_EQ(plan->contour, 1);
   const std::vector<std::string> preamble{"G21G90G94G17", "G94", "G0Z12.5"};
   EXPECT_EQ(plan->preamble, preamble) << "modal set-up, inverse time off, retract to the contour's rapid height";
   // Stopped on the marker itself: contour 0 had finished, restart at contour 1.
-  EXPECT_EQ(plan_resume(kProgram, 12)->restart_index, 12u);
+  EXPECT_EQ(resume_at(kProgram, 12)->restart_index, 12u);
   // Stopped in contour 0 after its last cut, before its jet-off (10) or its retract (11): the
   // contour is finished. It used to restart at contour 0 and cut it twice (the fault campaign).
-  EXPECT_EQ(plan_resume(kProgram, 11)->restart_index, 12u);
-  EXPECT_EQ(plan_resume(kProgram, 10)->restart_index, 12u);
-  EXPECT_EQ(plan_resume(kProgram, 10)->contour, 1);
+  EXPECT_EQ(resume_at(kProgram, 11)->restart_index, 12u);
+  EXPECT_EQ(resume_at(kProgram, 10)->restart_index, 12u);
+  EXPECT_EQ(resume_at(kProgram, 10)->contour, 1);
   // Its last cut not finished: the contour again.
-  EXPECT_EQ(plan_resume(kProgram, 9)->restart_index, 3u);
-  EXPECT_EQ(plan_resume(kProgram, 7)->restart_index, 3u) << "the pierce";
+  EXPECT_EQ(resume_at(kProgram, 9)->restart_index, 3u);
+  EXPECT_EQ(resume_at(kProgram, 7)->restart_index, 3u) << "the pierce";
   // The last contour's cut done: go on after it (jet off, program end), not into it again.
-  EXPECT_EQ(plan_resume(kProgram, 19)->restart_index, 19u);
-  EXPECT_EQ(plan_resume(kProgram, 18)->restart_index, 12u);
+  EXPECT_EQ(resume_at(kProgram, 19)->restart_index, 19u);
+  EXPECT_EQ(resume_at(kProgram, 18)->restart_index, 12u);
 }
 
 TEST(ResumePoint, BeforeTheFirstContourStartsOverAndWithoutMarkersRefuses) {
-  const auto top = plan_resume(kProgram, 2);
+  const auto top = resume_at(kProgram, 2);
   ASSERT_TRUE(top);
   EXPECT_EQ(top->restart_index, 0u);
   EXPECT_TRUE(top->preamble.empty());
   const std::vector<std::string> bare{"G21", "G0X1", "G1X2F100", "G1X3"};
-  const auto refused = plan_resume(bare, 2);
+  const auto refused = resume_at(bare, 2);
   ASSERT_FALSE(refused);
   EXPECT_EQ(refused.error().code, LinkErrorCode::bad_request);
   EXPECT_NE(refused.error().message.find("CONTOUR"), std::string::npos);
-  EXPECT_FALSE(plan_resume(kProgram, 99));
+  EXPECT_FALSE(resume_at(kProgram, 99));
+}
+
+TEST(ResumePoint, TheMarkersMapEachContourFromItsMarkerToItsLastCut) {
+  const ProgramMap map = program_map_from_markers(kProgram);
+  EXPECT_EQ(map.setup_end, 3u);
+  ASSERT_EQ(map.contours.size(), 2u);
+  EXPECT_EQ(map.contours[0].contour, 0);
+  EXPECT_EQ(map.contours[0].start_index, 3u);
+  EXPECT_EQ(map.contours[0].last_cut_index, 9u) << "the dwell is no cut";
+  EXPECT_EQ(map.contours[1].start_index, 12u);
+  EXPECT_EQ(map.contours[1].last_cut_index, 18u);
+}
+
+// Issue 18: the resume point came from parsing `(CONTOUR ` comments back, so a dialect with other
+// comment syntax (Siemens `;`) or other jet M-codes would have had no safe point, or a wrong one.
+// With the post's map the program's text is not searched for contours at all.
+TEST(ResumePoint, ThePostsMapNeedsNoMarkersNorTheJetsMCodes) {
+  const std::vector<std::string> siemens{
+      "; KNOB SHEET 1",      // 0
+      "G71 G90 G94 G17",     // 1
+      "; CONTOUR 0 L1-1",    // 2
+      "G0 X10 Y0 Z10",       // 3
+      "M62",                 // 4  jet on (a configurable M-code)
+      "G1 X20 F500",         // 5
+      "G1 X30",              // 6
+      "M63",                 // 7  jet off
+      "G0 Z10",              // 8
+      "; CONTOUR 1 L1-2",    // 9
+      "G0 X40 Y0 Z12",       // 10
+      "M62",                 // 11
+      "G1 X50 F500",         // 12
+      "M63",                 // 13
+      "M30",                 // 14
+  };
+  const ProgramMap map{2, {{0, 2, 6}, {1, 9, 12}}};
+  auto in_first = plan_resume(siemens, map, 6);
+  ASSERT_TRUE(in_first) << in_first.error().message;
+  EXPECT_EQ(in_first->restart_index, 2u);
+  EXPECT_EQ(in_first->contour, 0);
+  EXPECT_EQ(in_first->preamble, (std::vector<std::string>{"G71 G90 G94 G17", "G94", "G0Z10"}));
+  auto after_its_cut = plan_resume(siemens, map, 7);
+  ASSERT_TRUE(after_its_cut);
+  EXPECT_EQ(after_its_cut->restart_index, 9u) << "contour 0's last cut ran: it is not cut twice";
+  EXPECT_EQ(after_its_cut->contour, 1);
+  EXPECT_EQ(plan_resume(siemens, map, 13)->restart_index, 13u) << "after the last cut: go on to the end";
+  // The same program read for markers has none: refused, not resumed somewhere unsafe.
+  EXPECT_FALSE(resume_at(siemens, 6));
 }
 
 }  // namespace

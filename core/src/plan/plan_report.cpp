@@ -134,6 +134,10 @@ ReportSheet sheet_report(const SheetOutput& s, const std::vector<Part>& parts) {
   r.five_axis_moves = static_cast<std::int64_t>(prog.five_axis_moves);
   if (prog.five_axis_moves) r.bytes_per_five_axis_move = static_cast<double>(prog.five_axis_bytes) / prog.five_axis_moves;
   for (const Placement& pl : s.sheet.placements) r.parts.push_back(part_report(s, pl, parts));
+  r.setup_lines = static_cast<std::int64_t>(prog.setup_lines);
+  for (std::size_t c = 0; c < prog.contour_lines.size(); ++c)
+    r.contour_lines.push_back({static_cast<std::int64_t>(c), static_cast<std::int64_t>(prog.contour_lines[c]),
+                             static_cast<std::int64_t>(prog.contour_last_cut_lines[c])});
   return r;
 }
 

@@ -143,6 +143,12 @@ struct Fields<ReportSheetTime> {
       std::tuple{Field{"cutting", &S::cutting}, Field{"rapids", &S::rapids}, Field{"pierces", &S::pierces}};
 };
 template <>
+struct Fields<ReportContour> {
+  using S = ReportContour;
+  static constexpr auto all =
+      std::tuple{Field{"index", &S::index}, Field{"line", &S::line}, Field{"last_cut_line", &S::last_cut_line}};
+};
+template <>
 struct Fields<ReportSheet> {
   using S = ReportSheet;
   static constexpr auto all = std::tuple{
@@ -164,7 +170,9 @@ struct Fields<ReportSheet> {
       Field{"program_lines", &S::program_lines},
       Field{"five_axis_moves", &S::five_axis_moves},
       Field{"bytes_per_five_axis_move", &S::bytes_per_five_axis_move},
-      Field{"parts", &S::parts}};
+      Field{"parts", &S::parts},
+      Field{"setup_lines", &S::setup_lines},
+      Field{"contour_lines", &S::contour_lines}};
 };
 template <>
 struct Fields<PlanReport> {

@@ -112,6 +112,14 @@ struct ReportSheetTime {  // seconds
   double cutting = 0.0, rapids = 0.0, pierces = 0.0;
 };
 
+// Where a contour sits in its sheet's program (the post's PostedProgram): laminad resumes a
+// stopped cut at a contour's line, and knows a contour whose last cut ran is finished.
+struct ReportContour {
+  std::int64_t index = 0;          // the contour's number, as its (CONTOUR n …) marker says
+  std::int64_t line = 0;           // 1-based line of its start (the marker; a safe restart)
+  std::int64_t last_cut_line = 0;  // 1-based line of its last cutting move; 0: none
+};
+
 struct ReportSheet {
   std::int64_t index = 0;
   double thickness_mm = 0.0, width_mm = 0.0, length_mm = 0.0;
@@ -125,6 +133,8 @@ struct ReportSheet {
   std::int64_t program_bytes = 0, program_lines = 0, five_axis_moves = 0;
   std::optional<double> bytes_per_five_axis_move;
   std::vector<ReportPart> parts;
+  std::int64_t setup_lines = 0;  // the program's set-up: its lines before the first contour
+  std::vector<ReportContour> contour_lines;
 };
 
 struct PlanReport {

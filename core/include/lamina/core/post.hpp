@@ -42,7 +42,14 @@ struct PostedProgram {
   std::size_t motion_lines = 0;        // G0/G1 lines
   std::size_t five_axis_moves = 0;     // motion lines that carry A or C
   std::size_t five_axis_bytes = 0;     // their bytes, newline included
-  std::vector<std::size_t> contour_lines;  // 1-based line of each contour's marker, per ToolContour
+  // Where each contour is, for the link's resume point (issue 18: handed over with the program,
+  // never parsed back from its comments): 1-based line of each contour's marker (its safe
+  // restart: the lines after it restate every modal word), and of its last cutting move (a
+  // motion line with the jet on; 0 when the contour has none), per ToolContour. The lines
+  // before the first contour are the program's set-up.
+  std::vector<std::size_t> contour_lines;
+  std::vector<std::size_t> contour_last_cut_lines;
+  std::size_t setup_lines = 0;
   std::vector<AxisPose> poses;         // machine axes at the end of every ToolMove (same order)
 };
 

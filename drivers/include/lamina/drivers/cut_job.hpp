@@ -41,6 +41,9 @@ struct CutJobSettings {
   // hold_limit_s is a stop. Without a PLC a standing hold cannot turn the jet off: it is a stop.
   double hold_limit_s = 600;
   double jet_restart_s = 1.0;
+  // Where the program's contours are, as the post made it (the plan's report); none: read from
+  // its (CONTOUR n …) markers (a program from elsewhere, `lamina stream`).
+  std::optional<ProgramMap> program_map;
 };
 
 enum class CutState { ready, preparing, cutting, stopping, stopped, completed, failed };
@@ -122,6 +125,7 @@ class CutJob {
   MachineLink& link_;
   CellIo* cell_;
   std::vector<std::string> program_;
+  ProgramMap map_;
   CutJobSettings settings_;
   mutable std::mutex mutex_;
   CutReport report_;
