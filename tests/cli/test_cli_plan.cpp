@@ -341,10 +341,15 @@ TEST(CliPlan, ASizeThatSuggestsTheWrongUnitsIsSaid) {
   EXPECT_EQ(r.exit_code, 0) << r.out;
   EXPECT_TRUE(has_text(r, "2.70 mm at its largest): if the file is in inches, give --units in (it would be 68.6 mm)"))
       << r.out;
-  r = lamina("plan " + quoted(plate) + " --units in --stock 10 --no-programs --out " + quoted(out.path));
+  // A 100 mm bar read as inches is 2540 mm long (a bar, not the 120 mm plate: a 3 m plate's
+  // deviation alone took 2 s, 20 s under the sanitizers).
+  const fs::path bar = temp_file("mm-bar.stl");
+  write_box_stl(bar, 100, 1, 1);
+  r = lamina("plan " + quoted(bar) + " --units in --stock 10 --no-programs --out " + quoted(out.path));
   EXPECT_EQ(r.exit_code, 0) << r.out;
-  EXPECT_TRUE(has_text(r, "larger than the 2500 mm sheet: if the file is in mm, give --units mm (it would be 120.0 mm"))
+  EXPECT_TRUE(has_text(r, "larger than the 2500 mm sheet: if the file is in mm, give --units mm (it would be 100.0 mm"))
       << r.out;
+  fs::remove(bar);
   r = lamina("plan " + quoted(plate) + " --stock 0.5,1 --no-programs --out " + quoted(out.path));
   EXPECT_EQ(r.exit_code, 0) << r.out;
   EXPECT_FALSE(has_text(r, "--units")) << "a 120 mm plate in mm is plausible:\n" << r.out;
