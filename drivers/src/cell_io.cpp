@@ -37,17 +37,19 @@ struct CellIo::Impl {
     std::promise<Result> done;
   };
 
-  explicit Impl(CellIoSettings s)
+  Impl(CellIoSettings s, std::unique_ptr<RegisterBus> b)
       : settings(std::move(s)),
         log(driver_logger("cell")),
-        client(settings.plc, log) {
+        bus(b ? std::move(b) : make_modbus_bus(settings.plc, "cell")),
+        client(*bus) {
     client.set_abort([this] { return stopping.load(); });
     thread = std::thread([this] { run(); });
   }
 
   CellIoSettings settings;
   std::shared_ptr<spdlog::logger> log;
-  ModbusClient client;  // used on the thread only
+  std::unique_ptr<RegisterBus> bus;  // the PLC (Modbus TCP unless a test gives its own)
+  RegisterBus& client;               // used on the thread only
   std::thread thread;
 
   mutable std::mutex mutex;  // guards the queue and everything shared below
@@ -469,7 +471,8 @@ struct CellIo::Impl {
   }
 };
 
-CellIo::CellIo(CellIoSettings settings) : impl_(std::make_unique<Impl>(std::move(settings))) {}
+CellIo::CellIo(CellIoSettings settings, std::unique_ptr<RegisterBus> bus)
+    : impl_(std::make_unique<Impl>(std::move(settings), std::move(bus))) {}
 
 CellIo::~CellIo() {
   impl_->signal(impl_->stopping);

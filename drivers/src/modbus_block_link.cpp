@@ -35,17 +35,19 @@ std::optional<LinkError> check_program_lines(const std::vector<std::string>& lin
 }  // namespace
 
 struct ModbusBlockLink::Impl {
-  explicit Impl(ModbusBlockSettings s)
+  Impl(ModbusBlockSettings s, std::unique_ptr<RegisterBus> b)
       : settings(std::move(s)),
         log(driver_logger("modbus-link")),
-        client(settings.plc, log) {
+        bus(b ? std::move(b) : make_modbus_bus(settings.plc, "modbus-link")),
+        client(*bus) {
     client.set_abort([this] { return shutting_down.load() || stop_requested.load(); });
     thread = std::thread([this] { run(); });
   }
 
   ModbusBlockSettings settings;
   std::shared_ptr<spdlog::logger> log;
-  ModbusClient client;  // the thread's only
+  std::unique_ptr<RegisterBus> bus;  // the PLC (Modbus TCP unless a test gives its own)
+  RegisterBus& client;               // the thread's only
   std::thread thread;
 
   mutable std::mutex mutex;
@@ -261,8 +263,8 @@ std::optional<LinkError> ModbusBlockLink::check_lines(const std::vector<std::str
   return check_program_lines(lines, first_index);
 }
 
-ModbusBlockLink::ModbusBlockLink(ModbusBlockSettings settings)
-    : impl_(std::make_unique<Impl>(std::move(settings))) {}
+ModbusBlockLink::ModbusBlockLink(ModbusBlockSettings settings, std::unique_ptr<RegisterBus> bus)
+    : impl_(std::make_unique<Impl>(std::move(settings), std::move(bus))) {}
 
 ModbusBlockLink::~ModbusBlockLink() {
   {

@@ -165,4 +165,8 @@ std::expected<void, LinkError> ModbusClient::write_registers(int address, std::s
               });
 }
 
+std::unique_ptr<RegisterBus> make_modbus_bus(const ModbusEndpoint& plc, const std::string& logger_name) {
+  return std::make_unique<ModbusClient>(plc, driver_logger(logger_name));
+}
+
 }  // namespace lamina::drivers

@@ -1,6 +1,6 @@
 #pragma once
-// One libmodbus TCP connection with bounded, logged reconnects — shared by CellIo and
-// ModbusBlockLink. Not thread-safe: each owner uses it from its own thread only.
+// One libmodbus TCP connection with bounded, logged reconnects: the RegisterBus of CellIo and
+// ModbusBlockLink (register_bus.hpp). Not thread-safe: each owner uses it from its own thread only.
 //
 // Transport failures (ETIMEDOUT, EIO, ECONNRESET, EPIPE, ECONNREFUSED, EMBBADDATA, …) close the
 // socket and the request is retried on a new connection, up to max_reconnects times with a short
@@ -19,6 +19,7 @@
 
 #include "lamina/drivers/link_error.hpp"
 #include "lamina/drivers/modbus_endpoint.hpp"
+#include "lamina/drivers/register_bus.hpp"
 
 struct _modbus;  // libmodbus's modbus_t; its header stays in the .cpp
 
@@ -32,30 +33,30 @@ namespace lamina::drivers {
 // Named logger shared by every instance ("cell", "modbus-link"), created on first use.
 std::shared_ptr<spdlog::logger> driver_logger(const std::string& name);
 
-class ModbusClient {
+class ModbusClient final : public RegisterBus {
  public:
   ModbusClient(ModbusEndpoint target, std::shared_ptr<spdlog::logger> log);
   ~ModbusClient();
   ModbusClient(const ModbusClient&) = delete;
   ModbusClient& operator=(const ModbusClient&) = delete;
 
-  std::expected<std::vector<std::uint8_t>, LinkError> read_input_bits(int address, int count);
-  std::expected<std::vector<std::uint16_t>, LinkError> read_input_registers(int address, int count);
-  std::expected<std::vector<std::uint16_t>, LinkError> read_registers(int address, int count);
-  std::expected<void, LinkError> write_bit(int address, bool on);
+  std::expected<std::vector<std::uint8_t>, LinkError> read_input_bits(int address, int count) override;
+  std::expected<std::vector<std::uint16_t>, LinkError> read_input_registers(int address, int count) override;
+  std::expected<std::vector<std::uint16_t>, LinkError> read_registers(int address, int count) override;
+  std::expected<void, LinkError> write_bit(int address, bool on) override;
   // The same, but no reconnect is started after `give_up_at`: for a request that is worth
   // nothing late (a button press), an error instead of a late success.
-  std::expected<void, LinkError> write_bit_before(int address, bool on, std::chrono::steady_clock::time_point give_up_at);
-  std::expected<void, LinkError> write_bits(int address, std::span<const std::uint8_t> bits);
-  std::expected<void, LinkError> write_register(int address, std::uint16_t value);
-  std::expected<void, LinkError> write_registers(int address, std::span<const std::uint16_t> values);
+  std::expected<void, LinkError> write_bit_before(int address, bool on, std::chrono::steady_clock::time_point give_up_at) override;
+  std::expected<void, LinkError> write_bits(int address, std::span<const std::uint8_t> bits) override;
+  std::expected<void, LinkError> write_register(int address, std::uint16_t value) override;
+  std::expected<void, LinkError> write_registers(int address, std::span<const std::uint16_t> values) override;
 
-  bool connected() const { return ctx_ != nullptr; }
-  int reconnects() const { return reconnects_; }  // since construction
-  std::string where() const;                      // "127.0.0.1:502"
-  void close();
+  bool connected() const override { return ctx_ != nullptr; }
+  int reconnects() const override { return reconnects_; }  // since construction
+  std::string where() const override;             // "127.0.0.1:502"
+  void close() override;
   // Checked before every reconnect: true gives up at once (the owner is shutting down).
-  void set_abort(std::function<bool()> abort) { abort_ = std::move(abort); }
+  void set_abort(std::function<bool()> abort) override { abort_ = std::move(abort); }
 
  private:
   // Runs op on a connected context; the retry policy above. `what` names the request in errors.

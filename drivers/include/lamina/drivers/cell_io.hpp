@@ -15,6 +15,7 @@
 #include "lamina/drivers/controller_status.hpp"
 #include "lamina/drivers/link_error.hpp"
 #include "lamina/drivers/modbus_endpoint.hpp"
+#include "lamina/drivers/register_bus.hpp"
 
 namespace lamina::drivers {
 
@@ -68,7 +69,8 @@ struct CellStatus {
 class CellIo {
  public:
   // Starts the Modbus thread. Does not connect yet.
-  explicit CellIo(CellIoSettings settings);
+  // `bus`: the PLC's registers; none: Modbus TCP to settings.plc (tests give an in-memory PLC).
+  explicit CellIo(CellIoSettings settings, std::unique_ptr<RegisterBus> bus = nullptr);
   ~CellIo();  // jet off (best effort), stops the thread
   CellIo(const CellIo&) = delete;
   CellIo& operator=(const CellIo&) = delete;

@@ -8,6 +8,7 @@
 
 #include "lamina/drivers/machine_link.hpp"
 #include "lamina/drivers/modbus_endpoint.hpp"
+#include "lamina/drivers/register_bus.hpp"
 
 namespace lamina::drivers {
 
@@ -19,7 +20,8 @@ struct ModbusBlockSettings {
 
 class ModbusBlockLink final : public MachineLink {
  public:
-  explicit ModbusBlockLink(ModbusBlockSettings settings);
+  // `bus`: the PLC's registers; none: Modbus TCP to settings.plc (tests give an in-memory PLC).
+  explicit ModbusBlockLink(ModbusBlockSettings settings, std::unique_ptr<RegisterBus> bus = nullptr);
   ~ModbusBlockLink() override;
 
   std::optional<LinkError> check_lines(const std::vector<std::string>& lines, std::size_t first_index) const override;
