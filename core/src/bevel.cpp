@@ -355,35 +355,9 @@ void unwind_c(CutPass& pass) {
   }
 }
 
-LayerPlan plan_layer(const Mesh& mesh, const LayerSpan& span, int index, const std::vector<double>& zs,
-                     const std::vector<const Slice*>& sub_slices, const BevelParams& params) {
-  LayerPlan plan;
-  plan.index = index;
-  plan.z_bottom_mm = span.z_bottom_mm;
-  plan.thickness_mm = span.thickness_mm;
-  plan.sub_slice_z_mm = zs;
-  const double zb = span.z_bottom_mm, zt = span.z_top_mm();
-
-  std::vector<SectionLines> lines;
-  lines.reserve(sub_slices.size());
-  for (const Slice* s : sub_slices) lines.emplace_back(mesh, *s);
-
-  // How far in a sample may lie and still be this station's surface: what a line at the tilt
-  // limit reaches across the layer, plus a sub-slice of slack. Further in, the surface has
-  // turned (nearly) horizontal: the sample counts as absent and the profile gets a ledge.
-  const double tan_max = std::tan(std::min(params.fit.tilt_max_rad, 1.5));
-  const double reach = span.thickness_mm * std::max(tan_max, 1.0) + 2.0 * params.sub_slice_mm;
-  // The outline went through Clipper (1 nm grid) and was cleaned at 0.1 µm: a sub-slice that
-  // defines it may sit that much outside.
-  constexpr double kOnOutline = 1e-3;
-
-  std::vector<ProfileSample> samples(zs.size());
-  const SlabFacets slab(mesh, zs.front(), zs.back(), params.station_spacing_mm);
-  std::vector<ProfileBound> trace;
-  std::vector<std::uint32_t> scratch;
-  const auto rings = layer_outline_rings(sub_slices, facet_shadows(mesh, zs, lines), params.min_hole_width_mm);
-  // The outline as a section, to find how far out a line may go before it meets other material
-  // of the same layer.
+// The outline as a section, to find how far out a line may go before it meets other material
+// of the same layer.
+Slice outline_section(const std::vector<OutlineRing>& rings) {
   Slice outline_slice;
   for (const OutlineRing& ring : rings) {
     Loop loop;
@@ -392,78 +366,139 @@ LayerPlan plan_layer(const Mesh& mesh, const LayerSpan& span, int index, const s
     loop.area_mm2 = signed_area_mm2(ring.points);
     outline_slice.loops.push_back(std::move(loop));
   }
-  const SectionLines outline_lines(mesh, outline_slice);
+  return outline_slice;
+}
+
+// The outline here comes from material between sub-slices (a shadow), which the profile cannot
+// see: only the vertical cut on the outline is sure to stay outside.
+constexpr double kOnOutline = 1e-3;  // the outline went through Clipper (1 nm grid), cleaned at 0.1 µm
+
+// What one layer's stations read: its sub-slices' lines, the facets between them, the outline.
+struct StationContext {
+  const std::vector<SectionLines>& lines;
+  const SlabFacets& slab;
+  const SectionLines& outline_lines;
+  const std::vector<double>& zs;
+  double zb, zt, reach;
+  const BevelParams& params;
+  std::vector<ProfileSample> samples;
+  std::vector<ProfileBound> trace;
+  std::vector<std::uint32_t> scratch;
+};
+
+struct StationPlan {
+  CutStation station;
+  ProfileFit fit;
+  Eigen::Vector3d paper_v = Eigen::Vector3d::Zero();  // the paper's V = N × C
+};
+
+StationPlan plan_station(const StationSeed& seed, StationContext& cx) {
+  StationPlan out;
+  CutStation& st = out.station;
+  st.base_mm = seed.point;
+  st.normal = seed.normal;
+  Eigen::Vector3d top_normal = Eigen::Vector3d::Zero();
+  for (std::size_t j = 0; j < cx.zs.size(); ++j) {
+    ProfileSample& s = cx.samples[j];
+    s.z_mm = cx.zs[j];
+    const auto hit = cx.lines[j].exit_crossing(seed.point, seed.normal, -cx.reach, kOnOutline, CrossingPick::largest);
+    s.present = hit.has_value();
+    if (hit) {
+      s.u_mm = hit->u_mm;
+      s.slope = profile_slope(hit->normal, seed.normal);
+      st.surface_id = hit->surface_id;
+      top_normal = hit->normal;
+    }
+  }
+  cx.slab.trace(seed.point, seed.normal, -cx.reach, kOnOutline, cx.trace, cx.scratch);
+  // Walking out along the normal, the next material of the layer (leaving it along −n).
+  double ceiling = std::numeric_limits<double>::infinity();
+  if (const auto next = cx.outline_lines.exit_crossing(seed.point, -seed.normal, -cx.reach, -2 * kOnOutline,
+                                                       CrossingPick::largest))
+    ceiling = -next->u_mm - kOnOutline;
+  out.fit = fit_profile(cx.samples, cx.zb, cx.zt, cx.params.fit, cx.trace, ceiling);
+  double outermost = -std::numeric_limits<double>::infinity();
+  for (const auto& smp : cx.samples)
+    if (smp.present) outermost = std::max(outermost, smp.u_mm);
+  if (out.fit.cuts.empty() || outermost < -kOnOutline) {  // a shadow: the vertical cut on the outline
+    const double gap = std::isfinite(outermost) ? -outermost : 0.0;
+    out.fit.cuts.assign(1, CutLine1D{0.0, 0.0});
+    out.fit.max_deviation_mm = std::max(out.fit.max_deviation_mm, gap);
+  }
+  st.shape = out.fit.shape;
+  st.slope_rule_agrees = out.fit.slope_rule_agrees;
+  st.tilt_limited = out.fit.tilt_limited;
+  st.max_deviation_mm = out.fit.max_deviation_mm;
+  // The paper's V = N × C: C along the contour (material on its left), N the facet normal.
+  const Eigen::Vector3d c_dir(-seed.normal.y(), seed.normal.x(), 0.0);
+  const Eigen::Vector3d v = top_normal.cross(c_dir);
+  out.paper_v = v.norm() > 1e-12 ? Eigen::Vector3d(v.normalized()) : Eigen::Vector3d::Zero();
+  return out;
+}
+
+// The outline's passes: as many as its station with the most cuts; stations with one cut repeat
+// it, so every pass is a closed loop around the outline.
+void make_passes(LayerOutline& outline, const std::vector<ProfileFit>& fits, const std::vector<Eigen::Vector3d>& paper_vs,
+                 double zb, double zt) {
+  std::size_t pass_count = 1;
+  for (const auto& f : fits) pass_count = std::max(pass_count, f.cuts.size());
+  outline.passes.resize(pass_count);
+  for (std::size_t p = 0; p < pass_count; ++p) {
+    CutPass& pass = outline.passes[p];
+    pass.lines.reserve(fits.size());
+    for (std::size_t s = 0; s < fits.size(); ++s) {
+      const auto& cuts = fits[s].cuts;
+      const CutLine1D& cut = cuts[std::min(p * cuts.size() / pass_count, cuts.size() - 1)];
+      pass.lines.push_back(make_line(outline.stations[s], cut, zb, zt, paper_vs[s]));
+    }
+    unwind_c(pass);
+  }
+}
+
+LayerOutline plan_outline(const OutlineRing& ring, StationContext& cx, LayerPlan& plan) {
+  LayerOutline outline;
+  outline.is_hole = ring.is_hole;
+  outline.parent = ring.parent;
+  const auto seeds = station_seeds(ring.points, cx.params.station_spacing_mm);
+  std::vector<ProfileFit> fits;
+  std::vector<Eigen::Vector3d> paper_vs;
+  fits.reserve(seeds.size());
+  for (const StationSeed& seed : seeds) {
+    StationPlan sp = plan_station(seed, cx);
+    outline.max_deviation_mm = std::max(outline.max_deviation_mm, sp.fit.max_deviation_mm);
+    ++plan.shape_counts[static_cast<std::size_t>(sp.fit.shape)];
+    paper_vs.push_back(sp.paper_v);
+    outline.stations.push_back(sp.station);
+    fits.push_back(std::move(sp.fit));
+  }
+  make_passes(outline, fits, paper_vs, cx.zb, cx.zt);
+  return outline;
+}
+
+LayerPlan plan_layer(const Mesh& mesh, const LayerSpan& span, int index, const std::vector<double>& zs,
+                     const std::vector<const Slice*>& sub_slices, const BevelParams& params) {
+  LayerPlan plan;
+  plan.index = index;
+  plan.z_bottom_mm = span.z_bottom_mm;
+  plan.thickness_mm = span.thickness_mm;
+  plan.sub_slice_z_mm = zs;
+
+  std::vector<SectionLines> lines;
+  lines.reserve(sub_slices.size());
+  for (const Slice* s : sub_slices) lines.emplace_back(mesh, *s);
+  // How far in a sample may lie and still be this station's surface: what a line at the tilt
+  // limit reaches across the layer, plus a sub-slice of slack. Further in, the surface has
+  // turned (nearly) horizontal: the sample counts as absent and the profile gets a ledge.
+  const double tan_max = std::tan(std::min(params.fit.tilt_max_rad, 1.5));
+  const double reach = span.thickness_mm * std::max(tan_max, 1.0) + 2.0 * params.sub_slice_mm;
+  const SlabFacets slab(mesh, zs.front(), zs.back(), params.station_spacing_mm);
+  const auto rings = layer_outline_rings(sub_slices, facet_shadows(mesh, zs, lines), params.min_hole_width_mm);
+  const SectionLines outline_lines(mesh, outline_section(rings));
+  StationContext cx{lines, slab, outline_lines, zs, span.z_bottom_mm, span.z_top_mm(), reach, params,
+                    std::vector<ProfileSample>(zs.size()), {}, {}};
   for (const OutlineRing& ring : rings) {
-    LayerOutline outline;
-    outline.is_hole = ring.is_hole;
-    outline.parent = ring.parent;
-    const auto seeds = station_seeds(ring.points, params.station_spacing_mm);
-    std::vector<ProfileFit> fits;
-    std::vector<Eigen::Vector3d> paper_vs;
-    fits.reserve(seeds.size());
-    for (const StationSeed& seed : seeds) {
-      CutStation st;
-      st.base_mm = seed.point;
-      st.normal = seed.normal;
-      Eigen::Vector3d top_normal = Eigen::Vector3d::Zero();
-      for (std::size_t j = 0; j < zs.size(); ++j) {
-        ProfileSample& s = samples[j];
-        s.z_mm = zs[j];
-        const auto hit = lines[j].exit_crossing(seed.point, seed.normal, -reach, kOnOutline, CrossingPick::largest);
-        s.present = hit.has_value();
-        if (hit) {
-          s.u_mm = hit->u_mm;
-          s.slope = profile_slope(hit->normal, seed.normal);
-          st.surface_id = hit->surface_id;
-          top_normal = hit->normal;
-        }
-      }
-      slab.trace(seed.point, seed.normal, -reach, kOnOutline, trace, scratch);
-      // Walking out along the normal, the next material of the layer (leaving it along −n).
-      double ceiling = std::numeric_limits<double>::infinity();
-      if (const auto next = outline_lines.exit_crossing(seed.point, -seed.normal, -reach, -2 * kOnOutline, CrossingPick::largest)) {
-        ceiling = -next->u_mm - kOnOutline;
-      }
-      ProfileFit fit = fit_profile(samples, zb, zt, params.fit, trace, ceiling);
-      double outermost = -std::numeric_limits<double>::infinity();
-      for (const auto& smp : samples) {
-        if (smp.present) outermost = std::max(outermost, smp.u_mm);
-      }
-      if (fit.cuts.empty() || outermost < -kOnOutline) {
-        // The outline here comes from material between sub-slices (a shadow), which the
-        // profile cannot see: only the vertical cut on the outline is sure to stay outside.
-        const double gap = std::isfinite(outermost) ? -outermost : 0.0;
-        fit.cuts.assign(1, CutLine1D{0.0, 0.0});
-        fit.max_deviation_mm = std::max(fit.max_deviation_mm, gap);
-      }
-      st.shape = fit.shape;
-      st.slope_rule_agrees = fit.slope_rule_agrees;
-      st.tilt_limited = fit.tilt_limited;
-      st.max_deviation_mm = fit.max_deviation_mm;
-      outline.max_deviation_mm = std::max(outline.max_deviation_mm, fit.max_deviation_mm);
-      ++plan.shape_counts[static_cast<std::size_t>(fit.shape)];
-      // The paper's V = N × C: C along the contour (material on its left), N the facet normal.
-      const Eigen::Vector3d c_dir(-seed.normal.y(), seed.normal.x(), 0.0);
-      Eigen::Vector3d v = top_normal.cross(c_dir);
-      paper_vs.push_back(v.norm() > 1e-12 ? Eigen::Vector3d(v.normalized()) : Eigen::Vector3d::Zero());
-      outline.stations.push_back(st);
-      fits.push_back(std::move(fit));
-    }
-    std::size_t pass_count = 1;
-    for (const auto& f : fits) pass_count = std::max(pass_count, f.cuts.size());
-    outline.passes.resize(pass_count);
-    for (std::size_t p = 0; p < pass_count; ++p) {
-      CutPass& pass = outline.passes[p];
-      pass.lines.reserve(fits.size());
-      for (std::size_t s = 0; s < fits.size(); ++s) {
-        const auto& cuts = fits[s].cuts;
-        // Stations with one cut repeat it: every pass is a closed loop around the outline.
-        const CutLine1D& cut = cuts[std::min(p * cuts.size() / pass_count, cuts.size() - 1)];
-        pass.lines.push_back(make_line(outline.stations[s], cut, zb, zt, paper_vs[s]));
-      }
-      unwind_c(pass);
-    }
-    plan.passes = std::max(plan.passes, static_cast<int>(pass_count));
+    LayerOutline outline = plan_outline(ring, cx, plan);
+    plan.passes = std::max(plan.passes, static_cast<int>(outline.passes.size()));
     plan.max_deviation_mm = std::max(plan.max_deviation_mm, outline.max_deviation_mm);
     plan.outlines.push_back(std::move(outline));
   }

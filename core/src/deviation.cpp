@@ -84,24 +84,56 @@ double wall_sample_estimate(const BevelPlan& plan, double ds) {
   return total;
 }
 
-}  // namespace
+struct SectionAreas {
+  double xor_mm2 = 0.0, stack_mm2 = 0.0;
+};
 
-std::expected<Deviation, Error> measure_deviation(const Mesh& mesh, const BevelPlan& plan,
-                                                  const DeviationParams& params) {
-  if (!(params.step_mm > 0.0) || !std::isfinite(params.step_mm))
-    return bad(fmt::format("measure_deviation: step_mm must be finite and > 0 (got {})", params.step_mm));
-  if (!(params.distance_sample_mm > 0.0) || !std::isfinite(params.distance_sample_mm))
-    return bad(fmt::format("measure_deviation: distance_sample_mm must be finite and > 0 (got {})",
-                           params.distance_sample_mm));
-  if (mesh.faces.empty() || mesh.vertices.empty())
-    return std::unexpected(Error{ErrorCode::empty_mesh, "measure_deviation: the mesh has no facet"});
-  if (auto ok = check_plan(plan); !ok) return std::unexpected(ok.error());
-  constexpr double kMaxWallSamples = 5e7;
-  if (const double samples = wall_sample_estimate(plan, params.distance_sample_mm); samples > kMaxWallSamples)
-    return bad(fmt::format("measure_deviation: distance_sample_mm {} would take {:.3g} wall samples (more than {:.0e})",
-                           params.distance_sample_mm, samples, kMaxWallSamples));
+// One section: the model's (its slice) against the stack's (the layers cut there), as
+// |A xor B| = |A| + |B| − 2 |A ∩ B|: Clipper's XOR of two nearly equal sections returns thousands
+// of slivers and sorts out their nesting in quadratic time; the intersection is one clean polygon.
+SectionAreas section_areas(const Slice& slice, const BevelPlan& plan, double z) {
+  ClipperLib::Paths model;
+  for (const auto& loop : slice.loops) model.push_back(detail::to_clipper(loop.points));
+  ClipperLib::Paths stack;
+  int layers_here = 0;
+  for (const auto& layer : plan.layers) {
+    if (!(z >= layer.z_bottom_mm && z <= layer.z_top_mm())) continue;
+    const auto section = detail::to_clipper(layer_section(layer, z));
+    stack.insert(stack.end(), section.begin(), section.end());
+    ++layers_here;
+  }
+  if (layers_here > 1) {  // overlapping layers: their union
+    ClipperLib::Clipper u;
+    u.AddPaths(stack, ClipperLib::ptSubject, true);
+    u.Execute(ClipperLib::ctUnion, stack, ClipperLib::pftPositive, ClipperLib::pftPositive);
+  }
+  SectionAreas r;
+  r.stack_mm2 = detail::area_mm2(stack);
+  ClipperLib::Clipper c;
+  c.AddPaths(model, ClipperLib::ptSubject, true);
+  ClipperLib::Paths model_clean;
+  c.Execute(ClipperLib::ctUnion, model_clean, ClipperLib::pftPositive, ClipperLib::pftPositive);
+  const double model_area = detail::area_mm2(model_clean);
+  double common = 0.0;
+  if (!model_clean.empty() && !stack.empty()) {
+    c.Clear();
+    c.AddPaths(model_clean, ClipperLib::ptSubject, true);
+    c.AddPaths(stack, ClipperLib::ptClip, true);
+    ClipperLib::Paths both;
+    c.Execute(ClipperLib::ctIntersection, both, ClipperLib::pftPositive, ClipperLib::pftPositive);
+    common = detail::area_mm2(both);
+  }
+  r.xor_mm2 = std::max(0.0, model_area + r.stack_mm2 - 2.0 * common);
+  return r;
+}
 
-  // The z range of both solids, and the break points: every step, and every layer face.
+// The sections' heights and widths: every step over the z range of both solids, split at every
+// layer face; each measured in its middle.
+struct Sections {
+  std::vector<double> mids, widths;
+};
+
+std::expected<Sections, Error> sections_of(const Mesh& mesh, const BevelPlan& plan, double step_mm) {
   double z_lo = std::numeric_limits<double>::infinity(), z_hi = -z_lo;
   for (const auto& v : mesh.vertices) {
     z_lo = std::min(z_lo, v.z());
@@ -112,74 +144,64 @@ std::expected<Deviation, Error> measure_deviation(const Mesh& mesh, const BevelP
     z_lo = std::min(z_lo, layer.z_bottom_mm);
     z_hi = std::max(z_hi, layer.z_top_mm());
   }
-  const double steps = std::ceil((z_hi - z_lo) / params.step_mm);
+  const double steps = std::ceil((z_hi - z_lo) / step_mm);
   if (steps > kMaxDeviationSections)
     return bad(fmt::format("measure_deviation: {:.4g} mm at step {} mm is more than {:.0f} sections", z_hi - z_lo,
-                           params.step_mm, kMaxDeviationSections));
+                           step_mm, kMaxDeviationSections));
   const auto n_steps = std::max<std::size_t>(1, static_cast<std::size_t>(steps));
   std::vector<double> breaks;
   breaks.reserve(n_steps + 1 + 2 * plan.layers.size());
-  for (std::size_t k = 0; k <= n_steps; ++k) breaks.push_back(z_lo + static_cast<double>(k) * params.step_mm);
+  for (std::size_t k = 0; k <= n_steps; ++k) breaks.push_back(z_lo + static_cast<double>(k) * step_mm);
   const double first = breaks.front(), last = breaks.back();
   for (const auto& layer : plan.layers)
     for (const double z : {layer.z_bottom_mm, layer.z_top_mm()})
       if (z > first && z < last) breaks.push_back(z);
   std::sort(breaks.begin(), breaks.end());
-  std::vector<double> mids, widths;
-  mids.reserve(breaks.size());
-  widths.reserve(breaks.size());
+  Sections s;
+  s.mids.reserve(breaks.size());
+  s.widths.reserve(breaks.size());
   for (std::size_t i = 0; i + 1 < breaks.size(); ++i) {
     const double w = breaks[i + 1] - breaks[i];
     if (!(w > 1e-9)) continue;
-    mids.push_back(0.5 * (breaks[i] + breaks[i + 1]));
-    widths.push_back(w);
+    s.mids.push_back(0.5 * (breaks[i] + breaks[i + 1]));
+    s.widths.push_back(w);
   }
+  return s;
+}
+
+std::expected<void, Error> check_deviation_params(const DeviationParams& params) {
+  if (!(params.step_mm > 0.0) || !std::isfinite(params.step_mm))
+    return bad(fmt::format("measure_deviation: step_mm must be finite and > 0 (got {})", params.step_mm));
+  if (!(params.distance_sample_mm > 0.0) || !std::isfinite(params.distance_sample_mm))
+    return bad(fmt::format("measure_deviation: distance_sample_mm must be finite and > 0 (got {})",
+                           params.distance_sample_mm));
+  return {};
+}
+
+}  // namespace
+
+std::expected<Deviation, Error> measure_deviation(const Mesh& mesh, const BevelPlan& plan,
+                                                  const DeviationParams& params) {
+  if (auto ok = check_deviation_params(params); !ok) return std::unexpected(ok.error());
+  if (mesh.faces.empty() || mesh.vertices.empty())
+    return std::unexpected(Error{ErrorCode::empty_mesh, "measure_deviation: the mesh has no facet"});
+  if (auto ok = check_plan(plan); !ok) return std::unexpected(ok.error());
+  constexpr double kMaxWallSamples = 5e7;
+  if (const double samples = wall_sample_estimate(plan, params.distance_sample_mm); samples > kMaxWallSamples)
+    return bad(fmt::format("measure_deviation: distance_sample_mm {} would take {:.3g} wall samples (more than {:.0e})",
+                           params.distance_sample_mm, samples, kMaxWallSamples));
+  auto sections = sections_of(mesh, plan, params.step_mm);
+  if (!sections) return std::unexpected(sections.error());
+  const std::vector<double>& mids = sections->mids;
 
   SliceParams slice_params;
   slice_params.parallel = params.parallel;
   auto slices = slice_mesh(mesh, mids, slice_params);
   if (!slices) return std::unexpected(slices.error());
 
-  // Per section: XOR area and stack area; summed afterwards in section order, so the total does
-  // not depend on threads.
-  std::vector<double> xor_area(mids.size(), 0.0), stack_area(mids.size(), 0.0);
-  auto measure = [&](std::size_t i) {
-    const double z = mids[i];
-    ClipperLib::Paths model;
-    for (const auto& loop : (*slices)[i].loops) model.push_back(detail::to_clipper(loop.points));
-    ClipperLib::Paths stack;
-    int layers_here = 0;
-    for (const auto& layer : plan.layers) {
-      if (!(z >= layer.z_bottom_mm && z <= layer.z_top_mm())) continue;
-      const auto section = detail::to_clipper(layer_section(layer, z));
-      stack.insert(stack.end(), section.begin(), section.end());
-      ++layers_here;
-    }
-    if (layers_here > 1) {  // overlapping layers: their union
-      ClipperLib::Clipper c;
-      c.AddPaths(stack, ClipperLib::ptSubject, true);
-      c.Execute(ClipperLib::ctUnion, stack, ClipperLib::pftPositive, ClipperLib::pftPositive);
-    }
-    stack_area[i] = detail::area_mm2(stack);
-    // |A xor B| = |A| + |B| − 2 |A ∩ B|: Clipper's XOR of two nearly equal sections returns
-    // thousands of slivers and sorts out their nesting in quadratic time; the intersection is
-    // one clean polygon.
-    ClipperLib::Clipper c;
-    c.AddPaths(model, ClipperLib::ptSubject, true);
-    ClipperLib::Paths model_clean;
-    c.Execute(ClipperLib::ctUnion, model_clean, ClipperLib::pftPositive, ClipperLib::pftPositive);
-    const double model_area = detail::area_mm2(model_clean);
-    double common = 0.0;
-    if (!model_clean.empty() && !stack.empty()) {
-      c.Clear();
-      c.AddPaths(model_clean, ClipperLib::ptSubject, true);
-      c.AddPaths(stack, ClipperLib::ptClip, true);
-      ClipperLib::Paths both;
-      c.Execute(ClipperLib::ctIntersection, both, ClipperLib::pftPositive, ClipperLib::pftPositive);
-      common = detail::area_mm2(both);
-    }
-    xor_area[i] = std::max(0.0, model_area + stack_area[i] - 2.0 * common);
-  };
+  // Per section; summed afterwards in section order, so the total does not depend on threads.
+  std::vector<SectionAreas> areas(mids.size());
+  auto measure = [&](std::size_t i) { areas[i] = section_areas((*slices)[i], plan, mids[i]); };
   if (params.parallel)
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mids.size(), 4), [&](const tbb::blocked_range<std::size_t>& r) {
       for (std::size_t i = r.begin(); i != r.end(); ++i) measure(i);
@@ -189,8 +211,8 @@ std::expected<Deviation, Error> measure_deviation(const Mesh& mesh, const BevelP
 
   Deviation d;
   for (std::size_t i = 0; i < mids.size(); ++i) {
-    d.volume_mm3 += xor_area[i] * widths[i];
-    d.stack_volume_mm3 += stack_area[i] * widths[i];
+    d.volume_mm3 += areas[i].xor_mm2 * sections->widths[i];
+    d.stack_volume_mm3 += areas[i].stack_mm2 * sections->widths[i];
   }
   d.model_volume_mm3 = mesh_volume(mesh);
   d.volume_pct = d.model_volume_mm3 > 0.0 ? 100.0 * d.volume_mm3 / d.model_volume_mm3 : 0.0;

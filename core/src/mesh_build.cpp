@@ -126,114 +126,75 @@ std::optional<Error> check_params(const MeshParams& p) {
   return std::nullopt;
 }
 
-}  // namespace
-}  // namespace mesh_detail
-
-std::expected<Mesh, Error> build_mesh(const TriangleSoup& soup, const MeshParams& params) {
-  using namespace mesh_detail;
-  if (auto err = check_params(params)) return std::unexpected(std::move(*err));
-
-  const std::size_t nf_read = soup.triangle_count();
-  if (nf_read == 0) return std::unexpected(Error{ErrorCode::empty_mesh, "build_mesh: the input has no facets"});
-  if (nf_read > static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max() / 3))
-    return std::unexpected(Error{ErrorCode::unsupported,
-                                 fmt::format("build_mesh: {} facets is more than this build supports", nf_read)});
-
-  LAMINA_TIMER();
-  // Steps 1–2: build frame, non-finite facets, weld.
-  WeldResult w = weld_soup(soup, params);
-  LAMINA_TICK("weld");
-
-  // Step 3: facets on welded vertices; drop degenerate ones; number vertices by first use.
-  Mesh m;
-  const double area_min = w.tolerance * w.tolerance * params.degenerate_area_factor;
-  const double cross2_min = 4.0 * area_min * area_min;  // |(b − a) × (c − a)|² = (2·area)²
+// Step 3: facets on welded vertices; degenerate ones dropped; vertices numbered by first use.
+struct FacetStep {
   std::size_t degenerate = 0;
   Eigen::Vector3d first_degenerate = Eigen::Vector3d::Zero();
-  {
-    std::vector<std::int32_t> vmap(w.points.size(), -1);
-    m.faces.reserve(nf_read - w.nan_facets);
-    m.vertices.reserve(w.points.size());
-    for (std::size_t f = 0; f < nf_read; ++f) {
-      if (w.corner_point[3 * f] < 0) continue;
-      Tri t;
-      for (int k = 0; k < 3; ++k)
-        t[static_cast<std::size_t>(k)] = w.rep[static_cast<std::size_t>(w.corner_point[3 * f + static_cast<std::size_t>(k)])];
-      const Eigen::Vector3d& a = w.points[static_cast<std::size_t>(t[0])];
-      const Eigen::Vector3d& b = w.points[static_cast<std::size_t>(t[1])];
-      const Eigen::Vector3d& c = w.points[static_cast<std::size_t>(t[2])];
-      bool bad = t[0] == t[1] || t[1] == t[2] || t[0] == t[2];
-      if (!bad) {
-        const double cross2 = (b - a).cross(c - a).squaredNorm();
-        bad = !(cross2 > 0.0) || cross2 < cross2_min;
-      }
-      if (bad) {
-        if (degenerate == 0) first_degenerate = (a + b + c) / 3.0;
-        ++degenerate;
-        continue;
-      }
-      for (auto& v : t) {
-        auto& slot = vmap[static_cast<std::size_t>(v)];
-        if (slot < 0) {
-          slot = static_cast<std::int32_t>(m.vertices.size());
-          m.vertices.push_back(w.points[static_cast<std::size_t>(v)]);
-        }
-        v = slot;
-      }
-      m.faces.push_back(t);
+  double area_min = 0.0;
+};
+
+FacetStep collect_facets(const WeldResult& w, std::size_t nf_read, const MeshParams& params, Mesh& m) {
+  FacetStep r;
+  r.area_min = w.tolerance * w.tolerance * params.degenerate_area_factor;
+  const double cross2_min = 4.0 * r.area_min * r.area_min;  // |(b − a) × (c − a)|² = (2·area)²
+  std::vector<std::int32_t> vmap(w.points.size(), -1);
+  m.faces.reserve(nf_read - w.nan_facets);
+  m.vertices.reserve(w.points.size());
+  for (std::size_t f = 0; f < nf_read; ++f) {
+    if (w.corner_point[3 * f] < 0) continue;
+    Tri t;
+    for (int k = 0; k < 3; ++k)
+      t[static_cast<std::size_t>(k)] = w.rep[static_cast<std::size_t>(w.corner_point[3 * f + static_cast<std::size_t>(k)])];
+    const Eigen::Vector3d& a = w.points[static_cast<std::size_t>(t[0])];
+    const Eigen::Vector3d& b = w.points[static_cast<std::size_t>(t[1])];
+    const Eigen::Vector3d& c = w.points[static_cast<std::size_t>(t[2])];
+    bool bad = t[0] == t[1] || t[1] == t[2] || t[0] == t[2];
+    if (!bad) {
+      const double cross2 = (b - a).cross(c - a).squaredNorm();
+      bad = !(cross2 > 0.0) || cross2 < cross2_min;
     }
+    if (bad) {
+      if (r.degenerate == 0) r.first_degenerate = (a + b + c) / 3.0;
+      ++r.degenerate;
+      continue;
+    }
+    for (auto& v : t) {
+      auto& slot = vmap[static_cast<std::size_t>(v)];
+      if (slot < 0) {
+        slot = static_cast<std::int32_t>(m.vertices.size());
+        m.vertices.push_back(w.points[static_cast<std::size_t>(v)]);
+      }
+      v = slot;
+    }
+    m.faces.push_back(t);
   }
-  const std::size_t nan_facets = w.nan_facets, first_nan = w.first_nan_facet;
-  const std::size_t merged = w.tolerance_merged;
-  const double tolerance = w.tolerance;
-  Eigen::Vector3d first_merged = w.first_merged;
-  w = WeldResult{};  // release the weld tables before the topology is built
-  LAMINA_TICK("facets");
+  return r;
+}
 
-  if (m.faces.empty()) {
-    std::string why;
-    if (nan_facets == nf_read)
-      why = fmt::format("all {} facets have NaN or infinite coordinates", nf_read);
-    else
-      why = fmt::format("of {} facets, {} have NaN or infinite coordinates and {} are degenerate", nf_read,
-                        nan_facets, degenerate);
-    return std::unexpected(Error{ErrorCode::empty_mesh, "build_mesh: no usable facet: " + why});
-  }
+// What the steps found, for the defect lines (step 10), located in the build frame.
+struct BuildFacts {
+  std::size_t nf_read = 0, nan_facets = 0, first_nan = 0, merged = 0;
+  double tolerance = 0.0;
+  Eigen::Vector3d first_merged = Eigen::Vector3d::Zero();
+  FacetStep facets;
+  std::optional<Eigen::Vector3d> first_boundary, first_nonmanifold;
+};
 
-  // Lowest point at z = 0 (x and y as they are).
-  double zmin = std::numeric_limits<double>::infinity();
-  for (const auto& v : m.vertices) zmin = std::min(zmin, v.z());
-  for (auto& v : m.vertices) v.z() -= zmin;
-  first_degenerate.z() -= zmin;
-  first_merged.z() -= zmin;
-
-  // Steps 4–8.
-  Adjacency adj = build_edges(m.vertices.size(), m.faces, m.edges, m.edge_faces, m.face_edges);
-  LAMINA_TICK("edges");
-  compute_normals(m);
-  LAMINA_TICK("normals");
-  const OrientResult orient = orient_shells(m, adj, params.sharp_angle_rad);
-  adj.across = {};
-  LAMINA_TICK("orient");
-  const int surfaces = orient.surfaces;
-  renumber_surfaces(m, surfaces);
-  LAMINA_TICK("surfaces");
-
-  // Step 9: summary.
+// Step 9: the summary's counts, volume and box; the first open and non-manifold edges into `f`.
+void summarize(Mesh& m, const Adjacency& adj, const OrientResult& orient, int surfaces, BuildFacts& f) {
   MeshSummary& s = m.summary;
-  s.triangles_read = nf_read;
+  s.triangles_read = f.nf_read;
   s.triangles = m.faces.size();
   s.vertices = m.vertices.size();
   s.shells = static_cast<int>(m.shell_info.size());
   s.surfaces = surfaces;
-  std::optional<Eigen::Vector3d> first_boundary, first_nonmanifold;
   for (const std::int32_t ei : adj.odd_edges) {
     const Edge& e = m.edges[static_cast<std::size_t>(ei)];
     if (e.face_count == 1) {
-      if (!first_boundary) first_boundary = midpoint(m, e);
+      if (!f.first_boundary) f.first_boundary = midpoint(m, e);
       ++s.boundary_edges;
     } else if (e.face_count > 2) {
-      if (!first_nonmanifold) first_nonmanifold = midpoint(m, e);
+      if (!f.first_nonmanifold) f.first_nonmanifold = midpoint(m, e);
       ++s.nonmanifold_edges;
     }
   }
@@ -245,39 +206,48 @@ std::expected<Mesh, Error> build_mesh(const TriangleSoup& soup, const MeshParams
     s.bbox_min_mm = s.bbox_min_mm.cwiseMin(v);
     s.bbox_max_mm = s.bbox_max_mm.cwiseMax(v);
   }
+}
 
-  // Step 10: defects, one readable line each, located in the build frame.
+// Step 10, the repairs the weld and the facet step made.
+void add_repair_defects(Mesh& m, const BuildFacts& f) {
   auto& d = m.defects;
-  if (nan_facets > 0)
-    d.push_back(make_defect("nan_coordinates", Severity::repaired, nan_facets,
-                            fmt::format("{} {} with NaN or infinite coordinates dropped (first: facet {})", nan_facets,
-                                        plural(nan_facets, "facet", "facets"), first_nan)));
-  if (merged > 0)
+  if (f.nan_facets > 0)
+    d.push_back(make_defect("nan_coordinates", Severity::repaired, f.nan_facets,
+                            fmt::format("{} {} with NaN or infinite coordinates dropped (first: facet {})", f.nan_facets,
+                                        plural(f.nan_facets, "facet", "facets"), f.first_nan)));
+  if (f.merged > 0)
     d.push_back(make_defect(
-        "welded_vertices", Severity::repaired, merged,
+        "welded_vertices", Severity::repaired, f.merged,
         fmt::format("{} {} welded to a neighbour within {:.3g} mm (cracks an exact weld leaves open), e.g. at {}",
-                    merged, plural(merged, "vertex", "vertices"), tolerance, format_point(first_merged)),
-        first_merged));
+                    f.merged, plural(f.merged, "vertex", "vertices"), f.tolerance, format_point(f.first_merged)),
+        f.first_merged));
+  const std::size_t degenerate = f.facets.degenerate;
   if (degenerate > 0)
     d.push_back(make_defect("degenerate_facets", Severity::repaired, degenerate,
                             fmt::format("{} degenerate {} dropped (repeated vertex or area below {:.3g} mm²), e.g. at {}",
-                                        degenerate, plural(degenerate, "facet", "facets"), area_min,
-                                        format_point(first_degenerate)),
-                            first_degenerate));
+                                        degenerate, plural(degenerate, "facet", "facets"), f.facets.area_min,
+                                        format_point(f.facets.first_degenerate)),
+                            f.facets.first_degenerate));
+}
+
+// Step 10, what the topology found: open and non-manifold edges, winding.
+void add_topology_defects(Mesh& m, const OrientResult& orient, const BuildFacts& f) {
+  const MeshSummary& s = m.summary;
+  auto& d = m.defects;
   if (s.boundary_edges > 0) {
     const std::size_t places = boundary_places(m);
     d.push_back(make_defect("open_edges", Severity::error, s.boundary_edges,
                             fmt::format("{} open (boundary) {} in {} {}: the mesh is not closed, e.g. at {}",
                                         s.boundary_edges, plural(s.boundary_edges, "edge", "edges"), places,
-                                        plural(places, "place", "places"), format_point(*first_boundary)),
-                            first_boundary));
+                                        plural(places, "place", "places"), format_point(*f.first_boundary)),
+                            f.first_boundary));
   }
   if (s.nonmanifold_edges > 0)
     d.push_back(make_defect("nonmanifold_edges", Severity::warning, s.nonmanifold_edges,
                             fmt::format("{} non-manifold {} (shared by more than two facets), e.g. at {}",
                                         s.nonmanifold_edges, plural(s.nonmanifold_edges, "edge", "edges"),
-                                        format_point(*first_nonmanifold)),
-                            first_nonmanifold));
+                                        format_point(*f.first_nonmanifold)),
+                            f.first_nonmanifold));
   if (orient.facets_flipped > 0)
     d.push_back(make_defect("inconsistent_winding", Severity::repaired, orient.facets_flipped,
                             fmt::format("{} {} wound against {} neighbours turned over, e.g. at {}",
@@ -296,27 +266,96 @@ std::expected<Mesh, Error> build_mesh(const TriangleSoup& soup, const MeshParams
                                         plural(orient.shells_inverted, "shell was", "shells were"),
                                         format_point(orient.first_inverted)),
                             orient.first_inverted));
-  if (s.shells > 1) {
-    std::size_t solids = 0, cavities = 0, open = 0;
-    for (const ShellInfo& sh : m.shell_info) {
-      if (!sh.closed)
-        ++open;
-      else if (sh.volume_mm3 < 0.0)
-        ++cavities;
-      else
-        ++solids;
-    }
-    std::string kinds;
-    auto add = [&](std::size_t n, const char* one, const char* many) {
-      if (n == 0) return;
-      kinds += fmt::format("{}{} {}", kinds.empty() ? "" : ", ", n, plural(n, one, many));
-    };
-    add(solids, "solid", "solids");
-    add(cavities, "cavity", "cavities");
-    add(open, "open", "open");
-    d.push_back(make_defect("multiple_shells", Severity::info, static_cast<std::size_t>(s.shells),
-                            fmt::format("{} separate shells ({})", s.shells, kinds)));
+}
+
+// Step 10, several shells: how many solids, cavities and open ones.
+void add_shell_defects(Mesh& m) {
+  const MeshSummary& s = m.summary;
+  if (s.shells <= 1) return;
+  std::size_t solids = 0, cavities = 0, open = 0;
+  for (const ShellInfo& sh : m.shell_info) {
+    if (!sh.closed)
+      ++open;
+    else if (sh.volume_mm3 < 0.0)
+      ++cavities;
+    else
+      ++solids;
   }
+  std::string kinds;
+  auto add = [&](std::size_t n, const char* one, const char* many) {
+    if (n == 0) return;
+    kinds += fmt::format("{}{} {}", kinds.empty() ? "" : ", ", n, plural(n, one, many));
+  };
+  add(solids, "solid", "solids");
+  add(cavities, "cavity", "cavities");
+  add(open, "open", "open");
+  m.defects.push_back(make_defect("multiple_shells", Severity::info, static_cast<std::size_t>(s.shells),
+                                  fmt::format("{} separate shells ({})", s.shells, kinds)));
+}
+
+Error no_usable_facet(const BuildFacts& f) {
+  std::string why;
+  if (f.nan_facets == f.nf_read)
+    why = fmt::format("all {} facets have NaN or infinite coordinates", f.nf_read);
+  else
+    why = fmt::format("of {} facets, {} have NaN or infinite coordinates and {} are degenerate", f.nf_read,
+                      f.nan_facets, f.facets.degenerate);
+  return Error{ErrorCode::empty_mesh, "build_mesh: no usable facet: " + why};
+}
+
+}  // namespace
+}  // namespace mesh_detail
+
+std::expected<Mesh, Error> build_mesh(const TriangleSoup& soup, const MeshParams& params) {
+  using namespace mesh_detail;
+  if (auto err = check_params(params)) return std::unexpected(std::move(*err));
+
+  const std::size_t nf_read = soup.triangle_count();
+  if (nf_read == 0) return std::unexpected(Error{ErrorCode::empty_mesh, "build_mesh: the input has no facets"});
+  if (nf_read > static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max() / 3))
+    return std::unexpected(Error{ErrorCode::unsupported,
+                                 fmt::format("build_mesh: {} facets is more than this build supports", nf_read)});
+
+  LAMINA_TIMER();
+  // Steps 1–2: build frame, non-finite facets, weld.
+  WeldResult w = weld_soup(soup, params);
+  LAMINA_TICK("weld");
+  Mesh m;
+  BuildFacts f;
+  f.facets = collect_facets(w, nf_read, params, m);
+  f.nf_read = nf_read;
+  f.nan_facets = w.nan_facets, f.first_nan = w.first_nan_facet;
+  f.merged = w.tolerance_merged;
+  f.tolerance = w.tolerance;
+  f.first_merged = w.first_merged;
+  w = WeldResult{};  // release the weld tables before the topology is built
+  LAMINA_TICK("facets");
+  if (m.faces.empty()) return std::unexpected(no_usable_facet(f));
+
+  // Lowest point at z = 0 (x and y as they are).
+  double zmin = std::numeric_limits<double>::infinity();
+  for (const auto& v : m.vertices) zmin = std::min(zmin, v.z());
+  for (auto& v : m.vertices) v.z() -= zmin;
+  f.facets.first_degenerate.z() -= zmin;
+  f.first_merged.z() -= zmin;
+
+  // Steps 4–8.
+  Adjacency adj = build_edges(m.vertices.size(), m.faces, m.edges, m.edge_faces, m.face_edges);
+  LAMINA_TICK("edges");
+  compute_normals(m);
+  LAMINA_TICK("normals");
+  const OrientResult orient = orient_shells(m, adj, params.sharp_angle_rad);
+  adj.across = {};
+  LAMINA_TICK("orient");
+  const int surfaces = orient.surfaces;
+  renumber_surfaces(m, surfaces);
+  LAMINA_TICK("surfaces");
+
+  // Steps 9–10: summary and defects, one readable line each.
+  summarize(m, adj, orient, surfaces, f);
+  add_repair_defects(m, f);
+  add_topology_defects(m, orient, f);
+  add_shell_defects(m);
   LAMINA_TICK("summary");
   return m;
 }

@@ -169,6 +169,153 @@ Eigen::Vector3d to_build_frame(const Eigen::Vector3d& p, const Eigen::Matrix3d& 
   return (rotation * p) * scale;
 }
 
+namespace {
+
+Eigen::Vector3d point_of(const Key& k) {
+  Eigen::Vector3f p;
+  std::memcpy(p.data(), k.data(), sizeof k);
+  return Eigen::Vector3d(p.cast<double>());
+}
+
+// The distinct points of a soup, welded exactly (same float bits) through an open-addressing
+// table on the cell hash, and within `tol` through a union-find over neighbouring cells.
+//
+// Open addressing on the cell hash: a point sits in the probe run that starts at its cell's
+// slot, so the points of one cell (and, rarely, of cells hashing nearby) are contiguous, and the
+// bit pattern in the slot gives both identity and position. A closed mesh has about one point per
+// six corners: start at load <= 0.5 for that and double past 0.5.
+struct PointTable {
+  Grid grid;
+  double tol2 = 0.0;
+  double near = -1.0;  // in cell units; < 0: exact weld only
+  std::vector<Key> keys;  // the distinct points, in order of first appearance
+  UnionFind uf;
+  std::size_t cap = 0, mask = 0;
+  std::vector<Slot> table;
+
+  void make_table() {
+    table = {};
+    table.reserve(cap);
+    hint_huge_pages(table.data(), cap * sizeof(Slot));
+    table.assign(cap, Slot{{0, 0, 0}, -1});
+  }
+  void grow() {
+    cap <<= 1;
+    mask = cap - 1;
+    make_table();
+    for (std::size_t i = 0; i < keys.size(); ++i) {
+      std::size_t s = grid.hash(point_of(keys[i])) & mask;
+      while (table[s].id >= 0) s = (s + 1) & mask;
+      table[s] = Slot{keys[i], static_cast<std::int32_t>(i)};
+    }
+  }
+  // The id of k in the run starting at h; -1 and `free_slot` where it would go when new.
+  std::int32_t find(const Key& k, std::uint64_t h, std::size_t& free_slot) const {
+    std::size_t s = h & mask;
+    for (; table[s].id >= 0; s = (s + 1) & mask)
+      if (same(table[s].k, k)) return table[s].id;
+    free_slot = s;
+    return -1;
+  }
+  // Unites point i with every point within tol: its own cell's run and the neighbouring cells
+  // it lies within `near` of.
+  void unite_near(std::int32_t i, const Eigen::Vector3d& p, std::uint64_t h) {
+    auto visit = [&](std::size_t t) {
+      for (; table[t].id >= 0; t = (t + 1) & mask)
+        if ((point_of(table[t].k) - p).squaredNorm() <= tol2) uf.unite(i, table[t].id);
+    };
+    visit(h & mask);
+    double frac[3];
+    const auto c0 = grid.cell(p, frac);
+    std::int64_t cs[3][2];
+    int cn[3];
+    for (int a = 0; a < 3; ++a) {
+      cs[a][0] = c0[static_cast<std::size_t>(a)];
+      cn[a] = 1;
+      if (frac[a] < near)
+        cs[a][cn[a]++] = cs[a][0] - 1;
+      else if (frac[a] > 1.0 - near)
+        cs[a][cn[a]++] = cs[a][0] + 1;
+    }
+    if (cn[0] + cn[1] + cn[2] <= 3) return;
+    for (int ix = 0; ix < cn[0]; ++ix)
+      for (int iy = 0; iy < cn[1]; ++iy)
+        for (int iz = 0; iz < cn[2]; ++iz)
+          if (ix + iy + iz > 0) visit(hash_cell(cs[0][ix], cs[1][iy], cs[2][iz]) & mask);
+  }
+  // A new point at `free_slot`; its id.
+  std::int32_t add(const Key& k, const Eigen::Vector3d& p, std::uint64_t h, std::size_t free_slot) {
+    const auto i = static_cast<std::int32_t>(keys.size());
+    keys.push_back(k);
+    uf.parent.push_back(i);
+    if (near >= 0.0) unite_near(i, p, h);
+    table[free_slot] = Slot{k, i};
+    if (keys.size() * 2 > cap) grow();
+    return i;
+  }
+};
+
+// The grid, in file units. Cells far larger than the tolerance, so a point is rarely near a
+// face; the floor keeps cell indices well inside int64 for absurdly small tolerances.
+PointTable make_point_table(const Bounds& bounds, double tol, std::size_t corners) {
+  PointTable t;
+  const double diag = (bounds.hi - bounds.lo).norm();
+  const bool tolerant = tol > 0.0;
+  t.tol2 = tol * tol;
+  t.grid.lo = bounds.lo;
+  const double cell = diag > 0.0 ? std::max(tolerant ? tol * 64.0 : diag * 1e-5, diag * 1e-12) : 1.0;
+  t.grid.inv_cell = 1.0 / cell;
+  t.near = tolerant ? tol * t.grid.inv_cell * (1.0 + 1e-9) + 1e-12 : -1.0;
+  const std::size_t guess = corners / 5 + 16;
+  t.keys.reserve(guess);
+  t.uf.parent.reserve(guess);
+  t.cap = pow2_at_least(corners / 3 + 1);
+  t.mask = t.cap - 1;
+  t.make_table();
+  return t;
+}
+
+// Every corner's point id (-1 for a facet with a non-finite corner).
+void weld_corners(const TriangleSoup& soup, PointTable& t, std::vector<std::int32_t>& corner_point) {
+  const std::size_t nc = soup.triangle_count() * 3;
+  auto corner_hash = [&](std::size_t c) { return t.grid.hash(soup.corners[c].cast<double>()); };
+  // Neighbouring facets of a file share corners a few facets apart: a small cache of recent
+  // points answers most repeats without touching the big table (a cache miss each).
+  constexpr std::size_t kRecent = 1 << 14;
+  std::vector<Slot> recent(kRecent, Slot{{0, 0, 0}, -1});
+  bool facet_ok = true;
+  std::uint64_t ring[kAhead];
+  for (std::size_t c = 0; c < std::min(nc, kAhead); ++c) ring[c] = corner_hash(c);
+  for (std::size_t c = 0; c < nc; ++c) {
+    const std::uint64_t h = ring[c % kAhead];
+    if (c + kAhead < nc) {
+      const std::uint64_t ha = corner_hash(c + kAhead);
+      ring[c % kAhead] = ha;
+      __builtin_prefetch(&t.table[ha & t.mask]);
+    }
+    if (c % 3 == 0)
+      facet_ok = finite(key_of(soup.corners[c])) && finite(key_of(soup.corners[c + 1])) &&
+                 finite(key_of(soup.corners[c + 2]));
+    if (!facet_ok) {
+      corner_point[c] = -1;
+      continue;
+    }
+    const Key k = key_of(soup.corners[c]);
+    Slot& cached = recent[(h ^ (h >> 17)) & (kRecent - 1)];
+    if (cached.id >= 0 && same(cached.k, k)) {
+      corner_point[c] = cached.id;
+      continue;
+    }
+    std::size_t free_slot = 0;
+    std::int32_t id = t.find(k, h, free_slot);
+    if (id < 0) id = t.add(k, soup.corners[c].cast<double>(), h, free_slot);
+    cached = Slot{k, id};
+    corner_point[c] = id;
+  }
+}
+
+}  // namespace
+
 WeldResult weld_soup(const TriangleSoup& soup, const MeshParams& params) {
   WeldResult w;
   const std::size_t nf = soup.triangle_count();
@@ -182,142 +329,19 @@ WeldResult weld_soup(const TriangleSoup& soup, const MeshParams& params) {
     std::fill(w.corner_point.begin(), w.corner_point.end(), -1);
     return w;
   }
-
-  // The grid, in file units. Cells far larger than the tolerance, so a point is rarely near a
-  // face; the floor keeps cell indices well inside int64 for absurdly small tolerances.
-  const double diag = (bounds.hi - bounds.lo).norm();
-  const double tol = params.weld_tolerance_rel * diag;
-  const double tol2 = tol * tol;
-  const bool tolerant = tol > 0.0;
-  Grid grid;
-  grid.lo = bounds.lo;
-  const double cell = diag > 0.0 ? std::max(tolerant ? tol * 64.0 : diag * 1e-5, diag * 1e-12) : 1.0;
-  grid.inv_cell = 1.0 / cell;
-  const double near = tolerant ? tol * grid.inv_cell * (1.0 + 1e-9) + 1e-12 : -1.0;  // in cell units
-
-  std::vector<Key> keys;  // the distinct points, in order of first appearance
-  UnionFind uf;
-  const std::size_t guess = nc / 5 + 16;
-  keys.reserve(guess);
-  uf.parent.reserve(guess);
-
-  // Open addressing on the cell hash: a point sits in the probe run that starts at its cell's
-  // slot, so the points of one cell (and, rarely, of cells hashing nearby) are contiguous, and
-  // the bit pattern in the slot gives both identity and position. A closed mesh has about one
-  // point per six corners: start at load <= 0.5 for that and double past 0.5.
-  std::size_t cap = pow2_at_least(nc / 3 + 1);
-  std::size_t mask = cap - 1;
-  std::vector<Slot> table;
-  auto make_table = [&] {
-    table = {};
-    table.reserve(cap);
-    hint_huge_pages(table.data(), cap * sizeof(Slot));
-    table.assign(cap, Slot{{0, 0, 0}, -1});
-  };
-  make_table();
-  auto point_of = [](const Key& k) {
-    Eigen::Vector3f p;
-    std::memcpy(p.data(), k.data(), sizeof k);
-    return Eigen::Vector3d(p.cast<double>());
-  };
-  auto grow = [&] {
-    cap <<= 1;
-    mask = cap - 1;
-    make_table();
-    for (std::size_t i = 0; i < keys.size(); ++i) {
-      std::size_t s = grid.hash(point_of(keys[i])) & mask;
-      while (table[s].id >= 0) s = (s + 1) & mask;
-      table[s] = Slot{keys[i], static_cast<std::int32_t>(i)};
-    }
-  };
-  auto corner_hash = [&](std::size_t c) { return grid.hash(soup.corners[c].cast<double>()); };
-
-  constexpr std::size_t kRecent = 1 << 14;
-  std::vector<Slot> recent(kRecent, Slot{{0, 0, 0}, -1});
-  bool facet_ok = true;
-  std::uint64_t ring[kAhead];
-  for (std::size_t c = 0; c < std::min(nc, kAhead); ++c) ring[c] = corner_hash(c);
-  for (std::size_t c = 0; c < nc; ++c) {
-    const std::uint64_t h = ring[c % kAhead];
-    if (c + kAhead < nc) {
-      const std::uint64_t ha = corner_hash(c + kAhead);
-      ring[c % kAhead] = ha;
-      __builtin_prefetch(&table[ha & mask]);
-    }
-    if (c % 3 == 0)
-      facet_ok = finite(key_of(soup.corners[c])) && finite(key_of(soup.corners[c + 1])) &&
-                 finite(key_of(soup.corners[c + 2]));
-    if (!facet_ok) {
-      w.corner_point[c] = -1;
-      continue;
-    }
-    const Key k = key_of(soup.corners[c]);
-    // Neighbouring facets of a file share corners a few facets apart: a small cache of recent
-    // points answers most repeats without touching the big table (a cache miss each).
-    Slot& cached = recent[(h ^ (h >> 17)) & (kRecent - 1)];
-    if (cached.id >= 0 && same(cached.k, k)) {
-      w.corner_point[c] = cached.id;
-      continue;
-    }
-    std::size_t s = h & mask;
-    std::int32_t found = -1;
-    for (; table[s].id >= 0; s = (s + 1) & mask) {
-      if (same(table[s].k, k)) {
-        found = table[s].id;
-        break;
-      }
-    }
-    if (found >= 0) {  // a point seen before
-      w.corner_point[c] = found;
-      cached = Slot{k, found};
-      continue;
-    }
-
-    // A new point (s is the free slot ending its run).
-    const auto i = static_cast<std::int32_t>(keys.size());
-    keys.push_back(k);
-    uf.parent.push_back(i);
-    if (tolerant) {
-      const Eigen::Vector3d p = soup.corners[c].cast<double>();
-      auto visit = [&](std::size_t t) {
-        for (; table[t].id >= 0; t = (t + 1) & mask)
-          if ((point_of(table[t].k) - p).squaredNorm() <= tol2) uf.unite(i, table[t].id);
-      };
-      visit(h & mask);
-      double frac[3];
-      const auto c0 = grid.cell(p, frac);
-      std::int64_t cs[3][2];
-      int cn[3];
-      for (int a = 0; a < 3; ++a) {
-        cs[a][0] = c0[static_cast<std::size_t>(a)];
-        cn[a] = 1;
-        if (frac[a] < near)
-          cs[a][cn[a]++] = cs[a][0] - 1;
-        else if (frac[a] > 1.0 - near)
-          cs[a][cn[a]++] = cs[a][0] + 1;
-      }
-      if (cn[0] + cn[1] + cn[2] > 3) {
-        for (int ix = 0; ix < cn[0]; ++ix)
-          for (int iy = 0; iy < cn[1]; ++iy)
-            for (int iz = 0; iz < cn[2]; ++iz)
-              if (ix + iy + iz > 0) visit(hash_cell(cs[0][ix], cs[1][iy], cs[2][iz]) & mask);
-      }
-    }
-    table[s] = Slot{k, i};
-    cached = Slot{k, i};
-    w.corner_point[c] = i;
-    if (keys.size() * 2 > cap) grow();
-  }
-  table = {};
+  const double tol = params.weld_tolerance_rel * (bounds.hi - bounds.lo).norm();
+  PointTable t = make_point_table(bounds, tol, nc);
+  weld_corners(soup, t, w.corner_point);
+  t.table = {};
 
   // Representatives, the weld report, and the build frame.
-  const std::size_t n = keys.size();
+  const std::size_t n = t.keys.size();
   w.rep.resize(n);
   w.points.resize(n);
   const Eigen::Matrix3d rotation = build_frame_rotation(params);
   for (std::size_t i = 0; i < n; ++i) {
-    w.points[i] = to_build_frame(point_of(keys[i]), rotation, params.scale_to_mm);
-    const std::int32_t r = uf.find(static_cast<std::int32_t>(i));
+    w.points[i] = to_build_frame(point_of(t.keys[i]), rotation, params.scale_to_mm);
+    const std::int32_t r = t.uf.find(static_cast<std::int32_t>(i));
     w.rep[i] = r;
     if (r != static_cast<std::int32_t>(i)) {
       if (w.tolerance_merged == 0) w.first_merged = w.points[i];

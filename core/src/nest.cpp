@@ -157,52 +157,53 @@ SheetShortage count_placed_layers(std::span<const Part> parts, std::span<const i
   return s;
 }
 
-// The sheets of one thickness (numbered later), or the error naming the thickness.
-std::expected<std::vector<NestedSheet>, Error> nest_thickness(std::span<const Part> parts, std::span<const int> group,
-                                                              double thickness, const Stock& stock,
-                                                              const NestParams& params, SheetShortage& shortage) {
-  auto bad = [](std::string m) { return std::unexpected(Error{ErrorCode::invalid_argument, std::move(m)}); };
+std::unexpected<Error> nest_error(std::string m) { return std::unexpected(Error{ErrorCode::invalid_argument, std::move(m)}); }
+
+detail::SheetSize size_of(const SheetStock& s) { return detail::SheetSize{s.length_mm, s.width_mm}; }
+
+// The stock entries of this thickness, checked: known sizes, counts, and every part fits one.
+std::expected<std::vector<int>, Error> thickness_entries(std::span<const Part> parts, std::span<const int> group,
+                                                         double thickness, const Stock& stock, const NestParams& params) {
   std::vector<int> entries;
   for (int i = 0; i < static_cast<int>(stock.sheets.size()); ++i)
     if (std::abs(stock.sheets[i].thickness_mm - thickness) <= kSameThicknessMm) entries.push_back(i);
   if (entries.empty())
-    return bad(fmt::format("nest: no sheet of thickness {:g} mm in stock for {} part(s) (first {})", thickness,
-                           group.size(), label(parts[group.front()])));
+    return nest_error(fmt::format("nest: no sheet of thickness {:g} mm in stock for {} part(s) (first {})", thickness,
+                                  group.size(), label(parts[group.front()])));
   for (int e : entries) {
     const SheetStock& s = stock.sheets[e];
     if (!(s.width_mm > 0.0) || !(s.length_mm > 0.0) || !std::isfinite(s.width_mm) || !std::isfinite(s.length_mm))
-      return bad(fmt::format("nest: the {:g} mm sheet (stock entry {}) has no known size (length {:g}, width {:g} mm); "
-                             "nesting needs width_mm and length_mm",
-                             thickness, e + 1, s.length_mm, s.width_mm));
-    if (s.count < 0) return bad(fmt::format("nest: the {:g} mm sheet (stock entry {}) has count {}", thickness, e + 1, s.count));
+      return nest_error(fmt::format("nest: the {:g} mm sheet (stock entry {}) has no known size (length {:g}, width {:g} "
+                                    "mm); nesting needs width_mm and length_mm",
+                                    thickness, e + 1, s.length_mm, s.width_mm));
+    if (s.count < 0)
+      return nest_error(fmt::format("nest: the {:g} mm sheet (stock entry {}) has count {}", thickness, e + 1, s.count));
   }
-  auto size_of = [&](int e) { return detail::SheetSize{stock.sheets[e].length_mm, stock.sheets[e].width_mm}; };
   for (int p : group) {
-    const bool fits = std::any_of(entries.begin(), entries.end(),
-                                  [&](int e) { return detail::fits_on_sheet(parts[p], size_of(e), params); });
-    if (!fits) {
-      const detail::Bounds b = detail::rotated_bounds(parts[p].footprint_mm, 0.0);
-      std::string sizes;
-      for (int e : entries) sizes += (sizes.empty() ? "" : ", ") + sheet_size_text(stock.sheets[e]);
-      return bad(fmt::format("nest: part {} ({:.1f} x {:.1f} mm) is larger than every {:g} mm sheet ({}) less the "
-                             "{:g} mm margin",
-                             label(parts[p]), b.dx(), b.dy(), thickness, sizes, params.margin_mm));
-    }
+    const bool fits = std::any_of(entries.begin(), entries.end(), [&](int e) {
+      return detail::fits_on_sheet(parts[p], size_of(stock.sheets[e]), params);
+    });
+    if (fits) continue;
+    const detail::Bounds b = detail::rotated_bounds(parts[p].footprint_mm, 0.0);
+    std::string sizes;
+    for (int e : entries) sizes += (sizes.empty() ? "" : ", ") + sheet_size_text(stock.sheets[e]);
+    return nest_error(fmt::format("nest: part {} ({:.1f} x {:.1f} mm) is larger than every {:g} mm sheet ({}) less the "
+                                  "{:g} mm margin",
+                                  label(parts[p]), b.dx(), b.dy(), thickness, sizes, params.margin_mm));
   }
+  return entries;
+}
 
-  // Children in holes travel with their hosts: only the rest is packed.
-  detail::HoleFilling filling;
-  if (params.fill_holes) {
-    filling = detail::fill_holes(parts, group, params);
-  } else {
-    filling.free.assign(group.begin(), group.end());
-  }
+// Children in holes travel with their hosts: only the rest is packed.
+struct HostedTree {
   std::unordered_map<int, std::vector<const detail::HostedPart*>> children;
-  for (const detail::HostedPart& h : filling.hosted) children[h.host].push_back(&h);
+
+  explicit HostedTree(const detail::HoleFilling& filling) {
+    for (const detail::HostedPart& h : filling.hosted) children[h.host].push_back(&h);
+  }
   // A packed placement with its children (composed, recursively) before it; each child's `host`
   // is the index of the placement whose hole holds it.
-  std::function<void(const Placement&, std::vector<Placement>&)> emit = [&](const Placement& pl,
-                                                                            std::vector<Placement>& list) {
+  void emit(const Placement& pl, std::vector<Placement>& list) const {
     std::vector<std::size_t> direct;
     if (auto it = children.find(pl.part); it != children.end())
       for (const detail::HostedPart* h : it->second) {
@@ -211,73 +212,110 @@ std::expected<std::vector<NestedSheet>, Error> nest_thickness(std::span<const Pa
       }
     list.push_back(pl);
     for (std::size_t i : direct) list[i].host = static_cast<int>(list.size() - 1);
-  };
-  std::function<int(int)> carried = [&](int part) {
+  }
+  // The part and every part it carries.
+  int carried(int part) const {
     int n = 1;
     if (auto it = children.find(part); it != children.end())
       for (const detail::HostedPart* h : it->second) n += carried(h->in_host.part);
     return n;
-  };
+  }
+};
 
-  std::vector<NestedSheet> out;
-  std::vector<int> remaining = filling.free;
+NestedSheet nested_sheet(std::span<const Part> parts, const detail::PackedSheet& packed, int entry,
+                         const SheetStock& s, const HostedTree& tree) {
+  NestedSheet ns;
+  ns.stock_index = entry;
+  ns.thickness_mm = s.thickness_mm;
+  ns.width_mm = s.width_mm;
+  ns.length_mm = s.length_mm;
+  ns.material = s.material;
+  for (const Placement& pl : packed.placements) tree.emit(pl, ns.placements);
+  double area = 0.0;
+  for (const Placement& pl : ns.placements) area += parts[pl.part].area_mm2;
+  ns.utilisation = area / (s.width_mm * s.length_mm);
+  return ns;
+}
+
+// What the sheets of one thickness took, and what they could not.
+struct ThicknessFill {
+  std::vector<NestedSheet> sheets;
+  std::vector<int> remaining;  // parts left over
   int in_stock = 0;
-  int short_by = 0;  // sheets needed beyond the counts
+  int short_by = 0;            // sheets needed beyond the last kind's count
   std::string short_kind;
+};
+
+// Packs the stock entries in order; each takes what fits it, up to its count.
+ThicknessFill fill_entries(std::span<const Part> parts, const std::vector<int>& entries, const Stock& stock,
+                           const NestParams& params, const HostedTree& tree, std::vector<int> remaining) {
+  ThicknessFill f;
   for (std::size_t k = 0; k < entries.size() && !remaining.empty(); ++k) {
     const int e = entries[k];
     const SheetStock& s = stock.sheets[e];
-    const bool last = k + 1 == entries.size();
-    in_stock += s.count;
-    std::vector<int> here;
-    std::vector<int> later;
-    for (int p : remaining) (detail::fits_on_sheet(parts[p], size_of(e), params) ? here : later).push_back(p);
+    f.in_stock += s.count;
+    std::vector<int> here, later;
+    for (int p : remaining) (detail::fits_on_sheet(parts[p], size_of(s), params) ? here : later).push_back(p);
     std::vector<int> unplaced;
-    std::vector<detail::PackedSheet> sheets = pack(parts, here, size_of(e), params, unplaced);
+    std::vector<detail::PackedSheet> sheets = pack(parts, here, size_of(s), params, unplaced);
     later.insert(later.end(), unplaced.begin(), unplaced.end());
     const std::size_t take = s.count == 0 ? sheets.size() : std::min<std::size_t>(s.count, sheets.size());
     for (std::size_t i = 0; i < sheets.size(); ++i) {
-      if (i >= take) {
-        for (const Placement& pl : sheets[i].placements) later.push_back(pl.part);
+      if (i < take) {
+        f.sheets.push_back(nested_sheet(parts, sheets[i], e, s, tree));
         continue;
       }
-      NestedSheet ns;
-      ns.stock_index = e;
-      ns.thickness_mm = s.thickness_mm;
-      ns.width_mm = s.width_mm;
-      ns.length_mm = s.length_mm;
-      ns.material = s.material;
-      for (const Placement& pl : sheets[i].placements) emit(pl, ns.placements);
-      double area = 0.0;
-      for (const Placement& pl : ns.placements) area += parts[pl.part].area_mm2;
-      ns.utilisation = area / (s.width_mm * s.length_mm);
-      out.push_back(std::move(ns));
+      for (const Placement& pl : sheets[i].placements) later.push_back(pl.part);
     }
-    if (last && sheets.size() > take) {
-      short_by = static_cast<int>(sheets.size() - take);
-      short_kind = sheet_size_text(s);
+    if (k + 1 == entries.size() && sheets.size() > take) {
+      f.short_by = static_cast<int>(sheets.size() - take);
+      f.short_kind = sheet_size_text(s);
     }
     std::sort(later.begin(), later.end());
     remaining = std::move(later);
   }
-  if (!remaining.empty()) {
-    // Parts left over: those the last kind of sheet would take are counted as `short_by`; any
-    // others only fit an earlier (exhausted) kind.
-    std::string stock_text;
-    for (int e : entries)
-      stock_text += fmt::format("{}{} of {}", stock_text.empty() ? "" : ", ", stock.sheets[e].count,
-                                sheet_size_text(stock.sheets[e]));
-    const std::string needed =
-        short_by > 0 ? fmt::format("at least {} sheets needed ({} more of {})", in_stock + short_by, short_by, short_kind)
+  f.remaining = std::move(remaining);
+  return f;
+}
+
+// Parts left over: those the last kind of sheet would take are counted as `short_by`; any
+// others only fit an earlier (exhausted) kind.
+Error shortage_error(double thickness, const std::vector<int>& entries, const Stock& stock, const ThicknessFill& f,
+                     const HostedTree& tree) {
+  std::string stock_text;
+  for (int e : entries)
+    stock_text += fmt::format("{}{} of {}", stock_text.empty() ? "" : ", ", stock.sheets[e].count,
+                              sheet_size_text(stock.sheets[e]));
+  const std::string needed =
+      f.short_by > 0 ? fmt::format("at least {} sheets needed ({} more of {})", f.in_stock + f.short_by, f.short_by,
+                                   f.short_kind)
                      : std::string("more sheets of an earlier size needed");
-    int left = 0;
-    for (int p : remaining) left += carried(p);
-    shortage = count_placed_layers(parts, group, remaining, children);
+  int left = 0;
+  for (int p : f.remaining) left += tree.carried(p);
+  return Error{ErrorCode::stock_exhausted,
+               fmt::format("nest: not enough {:g} mm sheets: {} in stock ({}), {} part(s) left over; {}", thickness,
+                           f.in_stock, stock_text, left, needed)};
+}
+
+// The sheets of one thickness (numbered later), or the error naming the thickness.
+std::expected<std::vector<NestedSheet>, Error> nest_thickness(std::span<const Part> parts, std::span<const int> group,
+                                                              double thickness, const Stock& stock,
+                                                              const NestParams& params, SheetShortage& shortage) {
+  auto entries = thickness_entries(parts, group, thickness, stock, params);
+  if (!entries) return std::unexpected(entries.error());
+  detail::HoleFilling filling;
+  if (params.fill_holes)
+    filling = detail::fill_holes(parts, group, params);
+  else
+    filling.free.assign(group.begin(), group.end());
+  const HostedTree tree(filling);
+  ThicknessFill f = fill_entries(parts, *entries, stock, params, tree, filling.free);
+  if (!f.remaining.empty()) {
+    shortage = count_placed_layers(parts, group, f.remaining, tree.children);
     shortage.thickness_mm = thickness;
-    return std::unexpected(Error{ErrorCode::stock_exhausted, fmt::format("nest: not enough {:g} mm sheets: {} in stock ({}), {} part(s) left over; {}", thickness,
-                           in_stock, stock_text, left, needed)});
+    return std::unexpected(shortage_error(thickness, *entries, stock, f, tree));
   }
-  return out;
+  return std::move(f.sheets);
 }
 
 }  // namespace

@@ -42,10 +42,8 @@ std::optional<double> in_range_turn(double c, double prev_c, const HeadKinematic
   return c + two_pi * k;
 }
 
-}  // namespace
-
-std::expected<std::vector<AxisPose>, Error> plan_machine_axes(const SheetToolpath& toolpath,
-                                                             const HeadKinematics& head) {
+// Which contour each move belongs to (-1: none); contours must be disjoint runs of moves.
+std::expected<std::vector<int>, Error> contour_of_moves(const SheetToolpath& toolpath) {
   const std::vector<ToolMove>& moves = toolpath.moves;
   std::vector<int> contour_of(moves.size(), -1);
   for (std::size_t ci = 0; ci < toolpath.contours.size(); ++ci) {
@@ -61,8 +59,13 @@ std::expected<std::vector<AxisPose>, Error> plan_machine_axes(const SheetToolpat
       contour_of[i] = static_cast<int>(ci);
     }
   }
+  return contour_of;
+}
 
-  // 1. Continuous inverse over the whole program.
+// Step 1: continuous inverse over the whole program.
+std::expected<std::vector<AxisPose>, Error> continuous_inverse(const std::vector<ToolMove>& moves,
+                                                               const std::vector<int>& contour_of,
+                                                               const HeadKinematics& head) {
   std::vector<AxisPose> poses;
   poses.reserve(moves.size());
   double prev_c = 0.0;
@@ -77,23 +80,61 @@ std::expected<std::vector<AxisPose>, Error> plan_machine_axes(const SheetToolpat
     prev_c = pose->c_rad;
     poses.push_back(*pose);
   }
+  return poses;
+}
 
-  const bool limited = std::isfinite(head.c_min_rad) || std::isfinite(head.c_max_rad);
-  if (!limited || moves.empty()) return poses;
+// The moves [first, end) solved continuously from `prev`; none when one has no solution.
+std::optional<std::vector<AxisPose>> solve_run(const std::vector<ToolMove>& moves, std::size_t first, std::size_t end,
+                                               double prev, const HeadKinematics& head) {
+  std::vector<AxisPose> run;
+  for (std::size_t m = first; m < end; ++m) {
+    auto pose = inverse_kinematics(moves[m].tip_mm, moves[m].axis, prev, head);
+    if (!pose) return std::nullopt;
+    prev = pose->c_rad;
+    run.push_back(*pose);
+  }
+  return run;
+}
 
-  // 2. Limited C: per contour, one of the two branches of the inverse — (A, C) as it came, or
-  // (−A, C + π) all along — and one 2πk shift, chosen so the whole contour is in range and its first
-  // C is nearest to where the head was.
-  auto solve_run = [&](std::size_t first, std::size_t end, double prev) -> std::optional<std::vector<AxisPose>> {
-    std::vector<AxisPose> run;
-    for (std::size_t m = first; m < end; ++m) {
-      auto pose = inverse_kinematics(moves[m].tip_mm, moves[m].axis, prev, head);
-      if (!pose) return std::nullopt;
-      prev = pose->c_rad;
-      run.push_back(*pose);
+// One contour's choice: which branch (index into the options) and which 2πk.
+struct TurnChoice {
+  std::size_t option = 0;
+  double k = 0.0;
+};
+
+// The option and turn that keep the whole contour in range with its first C nearest `target`;
+// none when no option fits. `lo0`/`hi0`: the first option's C span, for the error.
+std::optional<TurnChoice> best_turn(const std::vector<std::vector<AxisPose>>& options, double target,
+                                    const HeadKinematics& head, double& lo0, double& hi0) {
+  std::optional<TurnChoice> best;
+  double best_cost = 0.0;
+  for (std::size_t o = 0; o < options.size(); ++o) {
+    double lo = options[o].front().c_rad, hi = lo;
+    for (const AxisPose& p : options[o]) {
+      lo = std::min(lo, p.c_rad);
+      hi = std::max(hi, p.c_rad);
     }
-    return run;
-  };
+    if (o == 0) lo0 = lo, hi0 = hi;
+    const double k_lo = std::ceil((head.c_min_rad - lo) / two_pi - 1e-12);
+    const double k_hi = std::floor((head.c_max_rad - hi) / two_pi + 1e-12);
+    if (k_lo > k_hi) continue;
+    const double first = options[o].front().c_rad;
+    const double k = std::clamp(std::round((target - first) / two_pi), k_lo, k_hi);
+    const double cost = std::abs(first + two_pi * k - target);
+    if (!best || cost < best_cost - 1e-12) {
+      best = TurnChoice{o, k};
+      best_cost = cost;
+    }
+  }
+  return best;
+}
+
+// Step 2, limited C: per contour, one of the two branches of the inverse — (A, C) as it came, or
+// (−A, C + π) all along — and one 2πk shift, chosen so the whole contour is in range and its
+// first C is nearest to where the head was. Writes the branch into `poses`; returns the shifts.
+std::expected<std::vector<double>, Error> contour_shifts(const SheetToolpath& toolpath, const HeadKinematics& head,
+                                                         std::vector<AxisPose>& poses) {
+  const std::vector<ToolMove>& moves = toolpath.moves;
   std::vector<double> shift(toolpath.contours.size(), 0.0);
   std::vector<std::size_t> order(toolpath.contours.size());
   for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
@@ -106,31 +147,11 @@ std::expected<std::vector<AxisPose>, Error> plan_machine_axes(const SheetToolpat
     std::vector<std::vector<AxisPose>> options;
     options.emplace_back(poses.begin() + static_cast<std::ptrdiff_t>(c.first_move),
                          poses.begin() + static_cast<std::ptrdiff_t>(c.end_move));
-    if (auto flipped = solve_run(c.first_move, c.end_move, poses[c.first_move].c_rad + std::numbers::pi);
+    if (auto flipped = solve_run(moves, c.first_move, c.end_move, poses[c.first_move].c_rad + std::numbers::pi, head);
         flipped && std::abs(flipped->front().a_rad - options[0].front().a_rad) > 1e-12)
       options.push_back(std::move(*flipped));
-    std::optional<std::size_t> best;
-    double best_k = 0.0, best_cost = 0.0, lo0 = 0.0, hi0 = 0.0;
-    for (std::size_t o = 0; o < options.size(); ++o) {
-      double lo = options[o].front().c_rad, hi = lo;
-      for (const AxisPose& p : options[o]) {
-        lo = std::min(lo, p.c_rad);
-        hi = std::max(hi, p.c_rad);
-      }
-      if (o == 0) lo0 = lo, hi0 = hi;
-      const double k_lo = std::ceil((head.c_min_rad - lo) / two_pi - 1e-12);
-      const double k_hi = std::floor((head.c_max_rad - hi) / two_pi + 1e-12);
-      if (k_lo > k_hi) continue;
-      const double first = options[o].front().c_rad;
-      const double target = last_c.value_or(0.0);
-      const double k = std::clamp(std::round((target - first) / two_pi), k_lo, k_hi);
-      const double cost = std::abs(first + two_pi * k - target);
-      if (!best || cost < best_cost - 1e-12) {
-        best = o;
-        best_k = k;
-        best_cost = cost;
-      }
-    }
+    double lo0 = 0.0, hi0 = 0.0;
+    const auto best = best_turn(options, last_c.value_or(0.0), head, lo0, hi0);
     if (!best)
       return std::unexpected(Error{
           ErrorCode::invalid_argument,
@@ -138,25 +159,26 @@ std::expected<std::vector<AxisPose>, Error> plan_machine_axes(const SheetToolpat
                       "[{:.3f}, {:.3f}] deg at any turn of either head solution",
                       ci, (hi0 - lo0) * deg_per_rad, lo0 * deg_per_rad, hi0 * deg_per_rad,
                       head.c_min_rad * deg_per_rad, head.c_max_rad * deg_per_rad)});
-    std::copy(options[*best].begin(), options[*best].end(), poses.begin() + static_cast<std::ptrdiff_t>(c.first_move));
-    shift[ci] = two_pi * best_k;
+    std::copy(options[best->option].begin(), options[best->option].end(),
+              poses.begin() + static_cast<std::ptrdiff_t>(c.first_move));
+    shift[ci] = two_pi * best->k;
     last_c = poses[c.end_move - 1].c_rad + shift[ci];
   }
+  return shift;
+}
 
-  // 3. Apply: contour moves take their contour's shift. A contour starts with the rapid over its
-  // pierce point at safe height, so the rewind is that rapid. Moves outside every contour (the
-  // park rapids; or a toolpath whose contours start at the pierce) take the previous contour's
-  // shift until the head is up at travel height, then the next one's (the rewind is the first move
-  // that starts at the run's highest point).
+// Step 3's shift of every move: contour moves take their contour's. A contour starts with the
+// rapid over its pierce point at safe height, so the rewind is that rapid. Moves outside every
+// contour (the park rapids; or a toolpath whose contours start at the pierce) take the previous
+// contour's shift until the head is up at travel height, then the next one's (the rewind is the
+// first move that starts at the run's highest point).
+std::vector<double> move_shifts(const std::vector<ToolMove>& moves, const std::vector<int>& contour_of,
+                                const std::vector<double>& shift) {
   std::vector<double> applied(moves.size(), 0.0);
-  std::vector<bool> assigned(moves.size(), false);
-  for (std::size_t ci = 0; ci < toolpath.contours.size(); ++ci)
-    for (std::size_t i = toolpath.contours[ci].first_move; i < toolpath.contours[ci].end_move; ++i) {
-      applied[i] = shift[ci];
-      assigned[i] = true;
-    }
-  std::size_t i = 0;
-  while (i < moves.size()) {
+  for (std::size_t m = 0; m < moves.size(); ++m)
+    if (contour_of[m] >= 0) applied[m] = shift[static_cast<std::size_t>(contour_of[m])];
+  auto start_z = [&](std::size_t m) { return m > 0 ? moves[m - 1].tip_mm.z() : moves[m].tip_mm.z(); };
+  for (std::size_t i = 0; i < moves.size();) {
     if (contour_of[i] >= 0) {
       ++i;
       continue;
@@ -168,25 +190,28 @@ std::expected<std::vector<AxisPose>, Error> plan_machine_axes(const SheetToolpat
     const bool has_before = begin > 0, has_after = end < moves.size();
     const double before = has_before ? shift[static_cast<std::size_t>(contour_of[begin - 1])] : 0.0;
     const double after = has_after ? shift[static_cast<std::size_t>(contour_of[end])] : 0.0;
-    auto start_z = [&](std::size_t m) { return m > 0 ? moves[m - 1].tip_mm.z() : moves[m].tip_mm.z(); };
     double top = start_z(begin);
     for (std::size_t m = begin; m < end; ++m) top = std::max(top, moves[m].tip_mm.z());
     std::size_t rewind = begin;
     while (rewind < end && start_z(rewind) < top - same_height_mm) ++rewind;
     if (rewind == end) rewind = end - 1;
-    for (std::size_t m = begin; m < end; ++m) {
-      const bool use_before = has_before && (m < rewind || !has_after);
-      applied[m] = use_before ? before : after;
-    }
+    for (std::size_t m = begin; m < end; ++m) applied[m] = has_before && (m < rewind || !has_after) ? before : after;
   }
+  return applied;
+}
 
+// Step 3: every move's C shifted into range; a move outside the contours that its shift leaves
+// out of range takes the turn in range nearest the move before.
+std::expected<void, Error> apply_shifts(const std::vector<ToolMove>& moves, const std::vector<int>& contour_of,
+                                        const std::vector<double>& applied, const HeadKinematics& head,
+                                        std::vector<AxisPose>& poses) {
   for (std::size_t m = 0; m < moves.size(); ++m) {
     const double c = poses[m].c_rad + applied[m];
     if (in_c_range(c, head)) {
       poses[m].c_rad = c;
       continue;
     }
-    if (assigned[m])  // cannot happen: the contour's shift was chosen to fit
+    if (contour_of[m] >= 0)  // cannot happen: the contour's shift was chosen to fit
       return std::unexpected(Error{ErrorCode::invalid_argument, fmt::format("contour {}: C out of range", contour_of[m])});
     const double prev = m > 0 ? poses[m - 1].c_rad : c;
     const auto turned = in_range_turn(poses[m].c_rad, prev, head);
@@ -198,6 +223,23 @@ std::expected<std::vector<AxisPose>, Error> plan_machine_axes(const SheetToolpat
                                                head.c_min_rad * deg_per_rad, head.c_max_rad * deg_per_rad)});
     poses[m].c_rad = *turned;
   }
+  return {};
+}
+
+}  // namespace
+
+std::expected<std::vector<AxisPose>, Error> plan_machine_axes(const SheetToolpath& toolpath,
+                                                             const HeadKinematics& head) {
+  auto contour_of = contour_of_moves(toolpath);
+  if (!contour_of) return std::unexpected(contour_of.error());
+  auto poses = continuous_inverse(toolpath.moves, *contour_of, head);
+  if (!poses) return poses;
+  const bool limited = std::isfinite(head.c_min_rad) || std::isfinite(head.c_max_rad);
+  if (!limited || toolpath.moves.empty()) return poses;
+  auto shift = contour_shifts(toolpath, head, *poses);
+  if (!shift) return std::unexpected(shift.error());
+  const std::vector<double> applied = move_shifts(toolpath.moves, *contour_of, *shift);
+  if (auto ok = apply_shifts(toolpath.moves, *contour_of, applied, head, *poses); !ok) return std::unexpected(ok.error());
   return poses;
 }
 

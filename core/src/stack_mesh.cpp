@@ -96,16 +96,23 @@ int winding(const std::vector<Eigen::Vector2d>& ring, const Eigen::Vector2d& p) 
   return w;
 }
 
-// Marks the points of every offending edge of a group at one height; false when it is clean
-// (no crossing or touching edges, no edge running against its base edge, outer counter-clockwise,
-// holes clockwise and inside the outer, outside each other).
-bool find_tangles(const Rings& rings, const Rings& base, Marks& marks) {
-  const std::size_t nr = rings.size();
-  marks.assign(nr, {});
+// The edges of a group at one height, and what is wrong with them (find_tangles below).
+struct TangleFinder {
+  struct Seg {
+    std::uint32_t ring, index;
+    Eigen::Vector2d a, b;
+  };
+  const Rings& rings;
+  const Rings& base;
+  Marks& marks;
+  std::vector<CompactRing> comp;
+  std::vector<char> whole;  // ring marked entirely
+  std::vector<Seg> segs;
+  Eigen::Vector2d lo{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
+  Eigen::Vector2d hi{-std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()};
   bool any = false;
-  std::vector<CompactRing> comp(nr);
-  std::vector<char> whole(nr, 0);  // ring marked entirely
-  auto mark_compact = [&](std::size_t r, std::size_t j) {
+
+  void mark_compact(std::size_t r, std::size_t j) {
     const CompactRing& c = comp[r];
     const std::size_t n = rings[r].size();
     for (std::size_t i = c.first[j];; i = (i + 1) % n) {
@@ -113,45 +120,67 @@ bool find_tangles(const Rings& rings, const Rings& base, Marks& marks) {
       if (i == c.last[j]) break;
     }
     any = true;
-  };
-  for (std::size_t r = 0; r < nr; ++r) {
-    marks[r].assign(rings[r].size(), 0);
-    if (!compact(rings[r], comp[r])) {
-      whole[r] = 1;
-      continue;
-    }
-    const double area = signed_area_mm2(comp[r].points);
-    if (!(r == 0 ? area > 0.0 : area < 0.0)) whole[r] = 1;
   }
 
-  struct Seg {
-    std::uint32_t ring, index;
-    Eigen::Vector2d a, b;
-  };
-  std::vector<Seg> segs;
-  Eigen::Vector2d lo(std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity());
-  Eigen::Vector2d hi = -lo;
-  for (std::size_t r = 0; r < nr; ++r) {
-    if (whole[r]) continue;
-    const CompactRing& c = comp[r];
-    const std::size_t m = c.points.size();
-    for (std::size_t j = 0; j < m; ++j) {
-      const std::size_t k = (j + 1) % m;
-      // Against its base edge (the original edge between the two runs).
-      const Eigen::Vector2d be = base[r][c.first[k]] - base[r][c.last[j]];
-      if (be.squaredNorm() > 1e-24 && (c.points[k] - c.points[j]).dot(be) < 0.0) {
-        mark_compact(r, j);
-        mark_compact(r, k);
+  // Rings that cannot be compacted, or wound the wrong way, are marked whole.
+  void compact_rings() {
+    const std::size_t nr = rings.size();
+    marks.assign(nr, {});
+    comp.resize(nr);
+    whole.assign(nr, 0);
+    for (std::size_t r = 0; r < nr; ++r) {
+      marks[r].assign(rings[r].size(), 0);
+      if (!compact(rings[r], comp[r])) {
+        whole[r] = 1;
+        continue;
       }
-      segs.push_back({static_cast<std::uint32_t>(r), static_cast<std::uint32_t>(j), c.points[j], c.points[k]});
-      lo = lo.cwiseMin(c.points[j]);
-      hi = hi.cwiseMax(c.points[j]);
+      const double area = signed_area_mm2(comp[r].points);
+      if (!(r == 0 ? area > 0.0 : area < 0.0)) whole[r] = 1;
+    }
+  }
+
+  // The segments of the rings not marked whole; an edge running against its base edge (the
+  // original edge between the two runs) is marked on the way.
+  void collect_segments() {
+    for (std::size_t r = 0; r < rings.size(); ++r) {
+      if (whole[r]) continue;
+      const CompactRing& c = comp[r];
+      const std::size_t m = c.points.size();
+      for (std::size_t j = 0; j < m; ++j) {
+        const std::size_t k = (j + 1) % m;
+        const Eigen::Vector2d be = base[r][c.first[k]] - base[r][c.last[j]];
+        if (be.squaredNorm() > 1e-24 && (c.points[k] - c.points[j]).dot(be) < 0.0) {
+          mark_compact(r, j);
+          mark_compact(r, k);
+        }
+        segs.push_back({static_cast<std::uint32_t>(r), static_cast<std::uint32_t>(j), c.points[j], c.points[k]});
+        lo = lo.cwiseMin(c.points[j]);
+        hi = hi.cwiseMax(c.points[j]);
+      }
+    }
+  }
+
+  bool offending(const Seg& s, const Seg& t) const {
+    const std::size_t m = comp[s.ring].points.size();
+    if (s.ring == t.ring && (s.index + 1) % m == t.index)  // consecutive: only a fold back onto itself
+      return orient(s.a, s.b, t.b) == 0.0 && (s.b - s.a).dot(t.b - t.a) < 0.0;
+    if (s.ring == t.ring && (t.index + 1) % m == s.index)
+      return orient(t.a, t.b, s.b) == 0.0 && (t.b - t.a).dot(s.b - s.a) < 0.0;
+    return segments_touch(s.a, s.b, t.a, t.b);
+  }
+
+  void mark_pair(const Seg& s, const Seg& t) {
+    for (const Seg* e : {&s, &t}) {
+      const std::size_t mm = comp[e->ring].points.size();
+      mark_compact(e->ring, e->index);
+      mark_compact(e->ring, (e->index + 1) % mm);
     }
   }
 
   // Crossings, through a uniform grid of the segments' boxes; a pair is tested in the cell that
   // holds the low corner of the overlap of their boxes.
-  if (!segs.empty()) {
+  void mark_crossings() {
+    if (segs.empty()) return;
     const Eigen::Vector2d size = (hi - lo).cwiseMax(1e-9);
     const int g = std::clamp(static_cast<int>(std::sqrt(static_cast<double>(segs.size()))), 1, 1024);
     const double cw = std::max(size.x(), size.y()) / g;
@@ -185,29 +214,16 @@ bool find_tangles(const Rings& rings, const Rings& base, Marks& marks) {
               oy > std::min(std::max(s.a.y(), s.b.y()), std::max(t.a.y(), t.b.y())))
             continue;  // boxes apart
           if (cell(ox, lo.x(), gx) != cx || cell(oy, lo.y(), gy) != cy) continue;
-          const std::size_t m = comp[s.ring].points.size();
-          bool offending;
-          if (s.ring == t.ring && (s.index + 1) % m == t.index) {
-            // Consecutive: only a fold back onto itself.
-            offending = orient(s.a, s.b, t.b) == 0.0 && (s.b - s.a).dot(t.b - t.a) < 0.0;
-          } else if (s.ring == t.ring && (t.index + 1) % m == s.index) {
-            offending = orient(t.a, t.b, s.b) == 0.0 && (t.b - t.a).dot(s.b - s.a) < 0.0;
-          } else {
-            offending = segments_touch(s.a, s.b, t.a, t.b);
-          }
-          if (!offending) continue;
-          for (const Seg* e : {&s, &t}) {
-            const std::size_t mm = comp[e->ring].points.size();
-            mark_compact(e->ring, e->index);
-            mark_compact(e->ring, (e->index + 1) % mm);
-          }
+          if (offending(s, t)) mark_pair(s, t);
         }
       }
     }
   }
 
   // Holes inside the outer and outside each other (with no crossing, one point tells).
-  if (!whole[0]) {
+  void check_holes() {
+    if (whole[0]) return;
+    const std::size_t nr = rings.size();
     for (std::size_t r = 1; r < nr; ++r) {
       if (whole[r]) continue;
       const Eigen::Vector2d& p = comp[r].points[0];
@@ -217,12 +233,27 @@ bool find_tangles(const Rings& rings, const Rings& base, Marks& marks) {
       if (bad) whole[r] = 1;
     }
   }
-  for (std::size_t r = 0; r < nr; ++r)
-    if (whole[r]) {
-      std::fill(marks[r].begin(), marks[r].end(), 1);
-      any = true;
-    }
-  return any;
+
+  void mark_wholes() {
+    for (std::size_t r = 0; r < rings.size(); ++r)
+      if (whole[r]) {
+        std::fill(marks[r].begin(), marks[r].end(), 1);
+        any = true;
+      }
+  }
+};
+
+// Marks the points of every offending edge of a group at one height; false when it is clean
+// (no crossing or touching edges, no edge running against its base edge, outer counter-clockwise,
+// holes clockwise and inside the outer, outside each other).
+bool find_tangles(const Rings& rings, const Rings& base, Marks& marks) {
+  TangleFinder f{rings, base, marks};
+  f.compact_rings();
+  f.collect_segments();
+  f.mark_crossings();
+  f.check_holes();
+  f.mark_wholes();
+  return f.any;
 }
 
 // The raw ring set pulled back onto `prev` where it is tangled (see the file comment).

@@ -196,91 +196,97 @@ void add_common(CLI::App* cmd, ClientOptions& o) {
   cmd->add_flag("--json", o.json, "print the daemon's answer as JSON");
 }
 
-}  // namespace
+// Prints the reply as JSON (--json) or as a person reads it.
+void print_or(const ClientOptions& o, const Json& result, const std::function<void(const Json&)>& human) {
+  if (o.json)
+    fmt::print("{}\n", result.dump(2));
+  else
+    human(result);
+}
 
-void add_client_commands(CLI::App& app, int& exit_code) {
-  auto o = std::make_shared<ClientOptions>();
-  auto print_or = [o](const Json& result, const std::function<void(const Json&)>& human) {
-    if (o->json) fmt::print("{}\n", result.dump(2));
-    else human(result);
+// --set KEY=VALUE… as the settings object: numbers and booleans as JSON, anything else as text.
+std::expected<Json, std::string> settings_from(const std::vector<std::string>& sets) {
+  Json settings = Json::object();
+  for (const std::string& kv : sets) {
+    const auto eq = kv.find('=');
+    if (eq == std::string::npos) return std::unexpected(fmt::format("--set {}: expected KEY=VALUE", kv));
+    const std::string key = kv.substr(0, eq), value = kv.substr(eq + 1);
+    try {
+      settings[key] = Json::parse(value);
+      if (settings[key].is_string() || settings[key].is_object() || settings[key].is_array()) settings[key] = value;
+    } catch (const std::exception&) {
+      settings[key] = value;
+    }
+  }
+  return settings;
+}
+
+void add_submit_command(CLI::App& app, const std::shared_ptr<ClientOptions>& o, int& exit_code) {
+  struct Submit {
+    std::string model, name;
+    std::vector<std::string> set;
+    bool follow = false;
+    bool upload = false;
   };
+  auto s = std::make_shared<Submit>();
+  auto* cmd = app.add_subcommand("submit", "submit a model to laminad: it plans it, then cuts it sheet by sheet");
+  cmd->add_option("model", s->model, "mesh file on the cell PC")->required();
+  cmd->add_option("--name", s->name, "the job's name (default: the file name)");
+  cmd->add_option("--set", s->set, "plan setting KEY=VALUE (docs/api.md), e.g. strategy=curved microjoints=2");
+  cmd->add_flag("--follow", s->follow, "show planning and cutting progress until the job needs you");
+  cmd->add_flag("--upload", s->upload, "send the file over the connection (the daemon is on another machine)");
+  add_common(cmd, *o);
+  cmd->callback([o, s, &exit_code] {
+    auto settings = settings_from(s->set);
+    if (!settings) {
+      fmt::print(stderr, "lamina submit: {}\n", settings.error());
+      exit_code = 2;
+      return;
+    }
+    std::error_code ec;
+    const std::string model = std::filesystem::absolute(s->model, ec).string();
+    Json params{{"model", model}, {"settings", *settings}};
+    if (s->upload) {
+      auto id = upload_file(*o, model);
+      if (!id) {
+        fmt::print(stderr, "lamina submit: {}\n", id.error());
+        exit_code = 1;
+        return;
+      }
+      params.erase("model");
+      params["upload"] = *id;
+    }
+    if (!s->name.empty()) params["name"] = s->name;
+    auto r = call(*o, "job.submit", params);
+    if (!r) {
+      exit_code = 1;
+      return;
+    }
+    print_or(*o, *r, [](const Json& j) { fmt::print("submitted {}\n", j.value("id", "?")); });
+    if (s->follow) exit_code = follow(*o, r->value("id", ""));
+  });
+}
 
-  // submit
-  {
-    struct Submit {
-      std::string model, name;
-      std::vector<std::string> set;
-      bool follow = false;
-      bool upload = false;
-    };
-    auto s = std::make_shared<Submit>();
-    auto* cmd = app.add_subcommand("submit", "submit a model to laminad: it plans it, then cuts it sheet by sheet");
-    cmd->add_option("model", s->model, "mesh file on the cell PC")->required();
-    cmd->add_option("--name", s->name, "the job's name (default: the file name)");
-    cmd->add_option("--set", s->set, "plan setting KEY=VALUE (docs/api.md), e.g. strategy=curved microjoints=2");
-    cmd->add_flag("--follow", s->follow, "show planning and cutting progress until the job needs you");
-    cmd->add_flag("--upload", s->upload, "send the file over the connection (the daemon is on another machine)");
-    add_common(cmd, *o);
-    cmd->callback([o, s, &exit_code, print_or] {
-      Json settings = Json::object();
-      for (const std::string& kv : s->set) {
-        const auto eq = kv.find('=');
-        if (eq == std::string::npos) {
-          fmt::print(stderr, "lamina submit: --set {}: expected KEY=VALUE\n", kv);
-          exit_code = 2;
-          return;
-        }
-        const std::string key = kv.substr(0, eq), value = kv.substr(eq + 1);
-        // Numbers and booleans as JSON; anything else as text.
-        try {
-          settings[key] = Json::parse(value);
-          if (settings[key].is_string() || settings[key].is_object() || settings[key].is_array()) settings[key] = value;
-        } catch (const std::exception&) {
-          settings[key] = value;
-        }
-      }
-      std::error_code ec;
-      const std::string model = std::filesystem::absolute(s->model, ec).string();
-      Json params{{"model", model}, {"settings", settings}};
-      if (s->upload) {
-        auto id = upload_file(*o, model);
-        if (!id) {
-          fmt::print(stderr, "lamina submit: {}\n", id.error());
-          exit_code = 1;
-          return;
-        }
-        params.erase("model");
-        params["upload"] = *id;
-      }
-      if (!s->name.empty()) params["name"] = s->name;
-      auto r = call(*o, "job.submit", params);
-      if (!r) {
-        exit_code = 1;
-        return;
-      }
-      print_or(*r, [](const Json& j) { fmt::print("submitted {}\n", j.value("id", "?")); });
-      if (s->follow) exit_code = follow(*o, r->value("id", ""));
+void add_jobs_command(CLI::App& app, const std::shared_ptr<ClientOptions>& o, int& exit_code) {
+  auto* cmd = app.add_subcommand("jobs", "list laminad's jobs");
+  add_common(cmd, *o);
+  cmd->callback([o, &exit_code] {
+    auto r = call(*o, "job.list");
+    if (!r) {
+      exit_code = 1;
+      return;
+    }
+    print_or(*o, *r, [](const Json& list) {
+      for (const Json& j : list)
+        fmt::print("{}  {:<13} {}  sheet {}/{}{}\n", j.value("id", "?"), j.value("state", "?"), j.value("name", ""),
+                   j.value("current_sheet", 0), j.value("sheets", 0),
+                   j.value("error", "").empty() ? "" : "  (" + j.value("error", "") + ")");
     });
-  }
-  // jobs
-  {
-    auto* cmd = app.add_subcommand("jobs", "list laminad's jobs");
-    add_common(cmd, *o);
-    cmd->callback([o, &exit_code, print_or] {
-      auto r = call(*o, "job.list");
-      if (!r) {
-        exit_code = 1;
-        return;
-      }
-      print_or(*r, [](const Json& list) {
-        for (const Json& j : list)
-          fmt::print("{}  {:<13} {}  sheet {}/{}{}\n", j.value("id", "?"), j.value("state", "?"), j.value("name", ""),
-                     j.value("current_sheet", 0), j.value("sheets", 0),
-                     j.value("error", "").empty() ? "" : "  (" + j.value("error", "") + ")");
-      });
-    });
-  }
-  // job / cancel / confirm: one job each; resume: a job, or without one the held machine
+  });
+}
+
+// job / cancel / confirm: one job each; resume: a job, or without one the held machine.
+void add_job_commands(CLI::App& app, const std::shared_ptr<ClientOptions>& o, int& exit_code) {
   {
     auto id = std::make_shared<std::string>();
     auto* cmd = app.add_subcommand(
@@ -288,14 +294,14 @@ void add_client_commands(CLI::App& app, int& exit_code) {
                   "without JOB: continue after a hold (as lamina continue)");
     cmd->add_option("job", *id, "job id");
     add_common(cmd, *o);
-    cmd->callback([o, id, &exit_code, print_or] {
+    cmd->callback([o, id, &exit_code] {
       auto r = id->empty() ? call(*o, "machine.resume") : call(*o, "job.resume", {{"job", *id}});
       if (!r) {
         exit_code = 1;
         return;
       }
-      if (id->empty()) print_or(*r, [](const Json& j) { fmt::print("{}\n", j.dump()); });
-      else print_or(*r, [](const Json& j) { print_job(j); });
+      if (id->empty()) print_or(*o, *r, [](const Json& j) { fmt::print("{}\n", j.dump()); });
+      else print_or(*o, *r, [](const Json& j) { print_job(j); });
     });
   }
   for (const auto& [name, method, help] : std::vector<std::tuple<std::string, std::string, std::string>>{
@@ -305,13 +311,13 @@ void add_client_commands(CLI::App& app, int& exit_code) {
     auto* cmd = app.add_subcommand(name, help);
     cmd->add_option("job", *id, "job id")->required();
     add_common(cmd, *o);
-    cmd->callback([o, id, method, &exit_code, print_or] {
+    cmd->callback([o, id, method, &exit_code] {
       auto r = call(*o, method, {{"job", *id}});
       if (!r) {
         exit_code = 1;
         return;
       }
-      print_or(*r, [](const Json& j) { print_job(j); });
+      print_or(*o, *r, [](const Json& j) { print_job(j); });
     });
   }
   {
@@ -321,26 +327,29 @@ void add_client_commands(CLI::App& app, int& exit_code) {
     cmd->add_option("job", *id, "job id")->required();
     cmd->add_option("sheet", *sheet, "sheet number")->required();
     add_common(cmd, *o);
-    cmd->callback([o, id, sheet, &exit_code, print_or] {
+    cmd->callback([o, id, sheet, &exit_code] {
       auto r = call(*o, "job.confirm_sheet", {{"job", *id}, {"sheet", *sheet}});
       if (!r) {
         exit_code = 1;
         return;
       }
-      print_or(*r, [](const Json& j) { print_job(j); });
+      print_or(*o, *r, [](const Json& j) { print_job(j); });
     });
   }
-  // status / hold / abort / machine resume
+}
+
+// status / hold / continue / abort: the machine.
+void add_machine_commands(CLI::App& app, const std::shared_ptr<ClientOptions>& o, int& exit_code) {
   {
     auto* cmd = app.add_subcommand("status", "the machine in one line: state, position, feed, line");
     add_common(cmd, *o);
-    cmd->callback([o, &exit_code, print_or] {
+    cmd->callback([o, &exit_code] {
       auto r = call(*o, "machine.status");
       if (!r) {
         exit_code = 1;
         return;
       }
-      print_or(*r, [](const Json& s) { fmt::print("{}\n", status_line(s)); });
+      print_or(*o, *r, [](const Json& s) { fmt::print("{}\n", status_line(s)); });
     });
   }
   for (const auto& [name, method, help] : std::vector<std::tuple<std::string, std::string, std::string>>{
@@ -349,15 +358,25 @@ void add_client_commands(CLI::App& app, int& exit_code) {
            {"abort", "machine.abort", "stop the cut now: jet off, motion held; resume or cancel the job afterwards"}}) {
     auto* cmd = app.add_subcommand(name, help);
     add_common(cmd, *o);
-    cmd->callback([o, method, &exit_code, print_or] {
+    cmd->callback([o, method, &exit_code] {
       auto r = call(*o, method);
       if (!r) {
         exit_code = 1;
         return;
       }
-      print_or(*r, [](const Json& j) { fmt::print("{}\n", j.dump()); });
+      print_or(*o, *r, [](const Json& j) { fmt::print("{}\n", j.dump()); });
     });
   }
+}
+
+}  // namespace
+
+void add_client_commands(CLI::App& app, int& exit_code) {
+  auto o = std::make_shared<ClientOptions>();
+  add_submit_command(app, o, exit_code);
+  add_jobs_command(app, o, exit_code);
+  add_job_commands(app, o, exit_code);
+  add_machine_commands(app, o, exit_code);
 }
 
 }  // namespace lamina::cli

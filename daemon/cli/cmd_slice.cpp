@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include <chrono>
+#include <expected>
 #include <memory>
 #include <set>
 
@@ -50,6 +51,66 @@ void print_table(const Mesh& mesh, const std::vector<Slice>& slices, bool all_ro
   }
 }
 
+// The heights to slice at, or the exit code after the error was said.
+std::expected<std::vector<double>, int> slice_heights(const SliceOptions& o, bool by_step, double height) {
+  std::vector<double> zs;
+  if (by_step) {
+    // Bounded by the model: the plane count is known only once its height is.
+    const double planes = planes_by_step(height, o.step_mm);
+    if (planes > static_cast<double>(kMaxSlicePlanes)) {
+      fmt::print(stderr,
+                 "error [invalid_argument]: --step {} mm gives {:.3g} planes over the model's {:.3f} mm, more than "
+                 "{}: give --step {:.3g} mm or more\n",
+                 o.step_mm, planes, height, kMaxSlicePlanes, height / static_cast<double>(kMaxSlicePlanes));
+      return std::unexpected(2);
+    }
+    zs = heights_by_step(height, o.step_mm);
+  }
+  for (double z : o.at_mm) {
+    if (z < 0.0 || z > height) fmt::print(stderr, "warning: z={} mm is outside the model (0 … {:.4f} mm)\n", z, height);
+    zs.push_back(z);
+  }
+  for (double f : o.at_fraction) zs.push_back(f * height);
+  return zs;
+}
+
+int run_slice(const SliceOptions& o, bool by_step) {
+  auto model = load_model(o.model);
+  if (!model) {
+    fmt::print(stderr, "error [{}]: {}\n", error_code_name(model.error().code), model.error().message);
+    return 1;
+  }
+  for (const Defect& d : model->mesh.defects)
+    if (d.severity == Severity::error || d.severity == Severity::warning)
+      fmt::print(stderr, "warning: {}: {}\n", d.code, d.message);
+  auto zs = slice_heights(o, by_step, model->mesh.summary.bbox_max_mm.z());
+  if (!zs) return zs.error();
+
+  SliceParams params;
+  params.gap_close_mm = o.gap_mm;
+  params.parallel = !o.serial;
+  const auto t0 = std::chrono::steady_clock::now();
+  auto slices = slice_mesh(model->mesh, *zs, params);
+  const double slice_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (!slices) {
+    fmt::print(stderr, "error [{}]: {}\n", error_code_name(slices.error().code), slices.error().message);
+    return 1;
+  }
+  print_table(model->mesh, *slices, o.all_rows);
+  fmt::print("timing: read {:.3f} s, topology {:.3f} s, slice {:.3f} s ({} slices, {} triangles)\n", model->read_s,
+             model->topology_s, slice_s, slices->size(), model->mesh.summary.triangles);
+  if (!o.json_path.empty()) {
+    std::unique_ptr<std::FILE, int (*)(std::FILE*)> f(std::fopen(o.json_path.c_str(), "w"), &std::fclose);
+    if (!f) {
+      fmt::print(stderr, "error [io_error]: cannot write {}\n", o.json_path);
+      return 1;
+    }
+    const nlohmann::json timing{{"read", model->read_s}, {"topology", model->topology_s}, {"slice", slice_s}};
+    write_slice_report(f.get(), o.model, *model, *slices, timing);
+  }
+  return 0;
+}
+
 }  // namespace
 
 void add_slice_command(CLI::App& app, int& exit_code) {
@@ -75,62 +136,7 @@ void add_slice_command(CLI::App& app, int& exit_code) {
       exit_code = 2;
       return;
     }
-    auto model = load_model(o->model);
-    if (!model) {
-      fmt::print(stderr, "error [{}]: {}\n", error_code_name(model.error().code), model.error().message);
-      exit_code = 1;
-      return;
-    }
-    for (const Defect& d : model->mesh.defects)
-      if (d.severity == Severity::error || d.severity == Severity::warning)
-        fmt::print(stderr, "warning: {}: {}\n", d.code, d.message);
-
-    const double height = model->mesh.summary.bbox_max_mm.z();
-    std::vector<double> zs;
-    if (step->count()) {
-      // Bounded by the model: the plane count is known only once its height is.
-      const double planes = planes_by_step(height, o->step_mm);
-      if (planes > static_cast<double>(kMaxSlicePlanes)) {
-        fmt::print(stderr,
-                   "error [invalid_argument]: --step {} mm gives {:.3g} planes over the model's {:.3f} mm, more than "
-                   "{}: give --step {:.3g} mm or more\n",
-                   o->step_mm, planes, height, kMaxSlicePlanes, height / static_cast<double>(kMaxSlicePlanes));
-        exit_code = 2;
-        return;
-      }
-      zs = heights_by_step(height, o->step_mm);
-    }
-    for (double z : o->at_mm) {
-      if (z < 0.0 || z > height) fmt::print(stderr, "warning: z={} mm is outside the model (0 … {:.4f} mm)\n", z, height);
-      zs.push_back(z);
-    }
-    for (double f : o->at_fraction) zs.push_back(f * height);
-
-    SliceParams params;
-    params.gap_close_mm = o->gap_mm;
-    params.parallel = !o->serial;
-    const auto t0 = std::chrono::steady_clock::now();
-    auto slices = slice_mesh(model->mesh, zs, params);
-    const double slice_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    if (!slices) {
-      fmt::print(stderr, "error [{}]: {}\n", error_code_name(slices.error().code), slices.error().message);
-      exit_code = 1;
-      return;
-    }
-    print_table(model->mesh, *slices, o->all_rows);
-    fmt::print("timing: read {:.3f} s, topology {:.3f} s, slice {:.3f} s ({} slices, {} triangles)\n",
-               model->read_s, model->topology_s, slice_s, slices->size(), model->mesh.summary.triangles);
-    if (!o->json_path.empty()) {
-      std::unique_ptr<std::FILE, int (*)(std::FILE*)> f(std::fopen(o->json_path.c_str(), "w"), &std::fclose);
-      if (!f) {
-        fmt::print(stderr, "error [io_error]: cannot write {}\n", o->json_path);
-        exit_code = 1;
-        return;
-      }
-      const nlohmann::json timing{{"read", model->read_s}, {"topology", model->topology_s}, {"slice", slice_s}};
-      write_slice_report(f.get(), o->model, *model, *slices, timing);
-    }
-    exit_code = 0;
+    exit_code = run_slice(*o, step->count() > 0);
   });
 }
 

@@ -96,81 +96,49 @@ RpcServerSettings server_settings(const ServerConfig& server) {
   return rs;
 }
 
-int run(const fs::path& config_path, bool check_only) {
-  auto config = load_daemon_config(config_path);
-  if (!config) {
-    spdlog::error("{}", config.error().message);
-    return 2;
-  }
-  if (check_only) {
-    fmt::print("{}: ok\n", config_path.string());
-    return 0;
-  }
-  config->planner.lamina_path = find_lamina(config->planner.lamina_path).string();
-
-  if (!prepare_folders(*config)) return 1;
-  auto store = JobStore::open(config->state_dir / "lamina.db");
+// The job store, its jobs recovered from the last stop; null once the error was said.
+std::unique_ptr<JobStore> open_store(const DaemonConfig& config) {
+  auto store = JobStore::open(config.state_dir / "lamina.db");
   if (!store) {
     spdlog::error("{}", store.error().message);
-    return 1;
+    return nullptr;
   }
   if (auto changed = (*store)->recover_after_restart(); !changed) {
     spdlog::error("{}", changed.error().message);
-    return 1;
+    return nullptr;
   } else if (!changed->empty()) {
     spdlog::warn("{} job(s) were cut short by the last stop: interrupted or planned again", changed->size());
   }
+  return std::move(*store);
+}
 
-  std::unique_ptr<MachineSession> machine;
-  try {
-    machine = std::make_unique<MachineSession>(*config);
-  } catch (const std::exception& e) {
-    spdlog::error("{}: {}", config->source, e.what());
-    return 2;
-  }
-
-  boost::asio::io_context io;
-  // Caught from here on: a SIGTERM during start-up (systemd stopping a unit it just started) is
-  // queued until the handler below is waiting, not the default action that kills us mid-write.
-  boost::asio::signal_set signals(io, SIGTERM, SIGINT);
-  RpcServerSettings rs = server_settings(config->server);
-
-  // Socket activation: laminad.socket hands over the Unix listener; TCP (if any) is ours to open.
+// Unix listeners systemd handed over (socket activation).
+std::vector<int> activated_listeners() {
   std::vector<int> activated;
   for (int fd : systemd::listen_fds())
     if (systemd::is_unix_stream_listener(fd)) activated.push_back(fd);
-  const bool adopted = !activated.empty();
-  if (adopted) rs.unix_path.clear();
+  return activated;
+}
 
-  RpcServer* server_ptr = nullptr;
-  JobManager jobs(*config, **store, *machine, [&server_ptr](const std::string& method, const nlohmann::json& params) {
-    if (server_ptr) server_ptr->broadcast(method, params);
-  });
-  Uploads uploads(config->state_dir / "uploads", UploadLimits{config->jobs.max_model_bytes, UploadLimits{}.max_chunk_bytes,
-                                                               config->jobs.max_uploads, config->jobs.upload_idle_s});
-  RpcServer server(io, rs, make_api_handler(jobs, uploads, ServerInfo{kVersion, machine->describe(), config->state_dir.string()}));
-  server_ptr = &server;
+// The activated listeners adopted, else our own socket; TCP (if any) is ours to open.
+bool start_listening(RpcServer& server, const std::vector<int>& activated, const RpcServerSettings& rs) {
   for (int fd : activated)
     if (auto r = server.adopt_unix_listener(fd); !r) {
       spdlog::error("socket activation: {}", r.error());
-      return 1;
+      return false;
     }
-  if (!adopted || rs.tcp_host) {
+  if (activated.empty() || rs.tcp_host) {
     if (auto r = server.listen(); !r) {
       spdlog::error("{}", r.error());
-      return 1;
+      return false;
     }
   }
-  if (auto r = jobs.start(); !r) {
-    spdlog::error("{}", r.error().message);
-    return 1;
-  }
-  spdlog::info("laminad {} ready: socket {}{}, {}, state in {}", kVersion,
-               adopted ? "(from systemd)" : config->server.socket_path,
-               rs.tcp_host ? fmt::format(", tcp {}:{}", *rs.tcp_host, server.tcp_port()) : std::string(),
-               machine->describe(), config->state_dir.string());
-  systemd::notify_ready(jobs.status_line());
+  return true;
+}
 
+// Runs the io_context: the machine's status to subscribers, systemd's status and watchdog; a
+// SIGTERM or SIGINT winds the jobs down off the io thread, which keeps pinging the watchdog.
+void serve(boost::asio::io_context& io, boost::asio::signal_set& signals, RpcServer& server, JobManager& jobs) {
   boost::asio::steady_timer status_timer(io), watchdog_timer(io), notify_timer(io);
   every(status_timer, std::chrono::milliseconds(500),
         [&] { server.broadcast("notify_machine_status", jobs.machine_status()); });
@@ -179,8 +147,7 @@ int run(const fs::path& config_path, bool check_only) {
     const auto half = std::chrono::duration_cast<std::chrono::milliseconds>(*period / 2);
     every(watchdog_timer, std::max(half, std::chrono::milliseconds(100)), [] { systemd::notify_watchdog(); });
   }
-
-  std::thread stopper;  // winds the jobs down off the io thread, which keeps pinging the watchdog
+  std::thread stopper;
   signals.async_wait([&](const boost::system::error_code& ec, int signal) {
     if (ec) return;
     spdlog::info("{}: stopping (machine held, cell made safe, jobs saved)", signal == SIGTERM ? "SIGTERM" : "SIGINT");
@@ -198,6 +165,57 @@ int run(const fs::path& config_path, bool check_only) {
   });
   io.run();
   if (stopper.joinable()) stopper.join();
+}
+
+int run(const fs::path& config_path, bool check_only) {
+  auto config = load_daemon_config(config_path);
+  if (!config) {
+    spdlog::error("{}", config.error().message);
+    return 2;
+  }
+  if (check_only) {
+    fmt::print("{}: ok\n", config_path.string());
+    return 0;
+  }
+  config->planner.lamina_path = find_lamina(config->planner.lamina_path).string();
+  if (!prepare_folders(*config)) return 1;
+  std::unique_ptr<JobStore> store = open_store(*config);
+  if (!store) return 1;
+  std::unique_ptr<MachineSession> machine;
+  try {
+    machine = std::make_unique<MachineSession>(*config);
+  } catch (const std::exception& e) {
+    spdlog::error("{}: {}", config->source, e.what());
+    return 2;
+  }
+
+  boost::asio::io_context io;
+  // Caught from here on: a SIGTERM during start-up (systemd stopping a unit it just started) is
+  // queued until the handler below is waiting, not the default action that kills us mid-write.
+  boost::asio::signal_set signals(io, SIGTERM, SIGINT);
+  RpcServerSettings rs = server_settings(config->server);
+  const std::vector<int> activated = activated_listeners();
+  if (!activated.empty()) rs.unix_path.clear();
+
+  RpcServer* server_ptr = nullptr;
+  JobManager jobs(*config, *store, *machine, [&server_ptr](const std::string& method, const nlohmann::json& params) {
+    if (server_ptr) server_ptr->broadcast(method, params);
+  });
+  Uploads uploads(config->state_dir / "uploads", UploadLimits{config->jobs.max_model_bytes, UploadLimits{}.max_chunk_bytes,
+                                                               config->jobs.max_uploads, config->jobs.upload_idle_s});
+  RpcServer server(io, rs, make_api_handler(jobs, uploads, ServerInfo{kVersion, machine->describe(), config->state_dir.string()}));
+  server_ptr = &server;
+  if (!start_listening(server, activated, rs)) return 1;
+  if (auto r = jobs.start(); !r) {
+    spdlog::error("{}", r.error().message);
+    return 1;
+  }
+  spdlog::info("laminad {} ready: socket {}{}, {}, state in {}", kVersion,
+               !activated.empty() ? "(from systemd)" : config->server.socket_path,
+               rs.tcp_host ? fmt::format(", tcp {}:{}", *rs.tcp_host, server.tcp_port()) : std::string(),
+               machine->describe(), config->state_dir.string());
+  systemd::notify_ready(jobs.status_line());
+  serve(io, signals, server, jobs);
   jobs.shutdown("the daemon was stopped");
   spdlog::info("stopped");
   return 0;

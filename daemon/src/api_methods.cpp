@@ -103,49 +103,43 @@ RpcError rpc_error(const JobError& e) {
   return RpcError{code, e.message, nullptr};
 }
 
-RpcServer::Handler make_api_handler(JobManager& jobs, Uploads& uploads, ServerInfo info) {
-  auto methods = std::make_shared<std::map<std::string, Method>>();
-  auto& m = *methods;
+namespace {
 
-  m["server.info"] = [info](const Json&, ClientContext&) -> RpcResult {
-    return Json{{"name", "laminad"}, {"version", info.version}, {"machine", info.machine}, {"state_dir", info.state_dir},
-                {"api", 1}};
-  };
-  m["server.subscribe"] = [](const Json&, ClientContext& client) -> RpcResult {
-    client.subscribed = true;
-    return Json{{"subscribed", true}, {"notifications", {"notify_job_progress", "notify_machine_status"}}};
-  };
-  add_upload_methods(m, uploads);
-  m["job.submit"] = [&jobs, &uploads](const Json& params, ClientContext&) -> RpcResult {
-    auto p = object_params(params);
-    if (!p) return std::unexpected(p.error());
-    SubmitRequest r;
-    if (params.contains("upload") == params.contains("model"))
-      return std::unexpected(invalid("params: give either model (a path on the cell PC) or upload (from upload.begin)"));
-    for (const auto& [key, value] : params.items())
-      if (key != "model" && key != "upload" && key != "name" && key != "settings")
-        return std::unexpected(invalid(fmt::format("params.{}: unknown parameter", key)));
-    if (auto it = params.find("name"); it != params.end()) {
-      if (!it->is_string()) return std::unexpected(invalid("params.name: expected a string"));
-      r.name = it->get<std::string>();
-    }
-    if (auto it = params.find("settings"); it != params.end()) r.settings = *it;
-    // Checked before an upload is taken: a mistyped setting leaves the upload for the next try.
-    if (auto args = plan_args_from_settings(r.settings); !args) return std::unexpected(invalid(args.error()));
-    if (params.contains("upload")) {
-      auto id = string_param(params, "upload");
-      if (!id) return std::unexpected(id.error());
-      auto file = uploads.take(*id);
-      if (!file) return std::unexpected(file.error());
-      r.model_path = file->string();
-      r.move_into_job = true;
-    } else {
-      auto model = string_param(params, "model");
-      if (!model) return std::unexpected(model.error());
-      r.model_path = *model;
-    }
-    return job_result(jobs.submit(std::move(r)));
-  };
+// job.submit: a model named on the cell PC or sent with upload.begin, with plan settings.
+RpcResult submit_job(JobManager& jobs, Uploads& uploads, const Json& params) {
+  auto p = object_params(params);
+  if (!p) return std::unexpected(p.error());
+  SubmitRequest r;
+  if (params.contains("upload") == params.contains("model"))
+    return std::unexpected(invalid("params: give either model (a path on the cell PC) or upload (from upload.begin)"));
+  for (const auto& [key, value] : params.items())
+    if (key != "model" && key != "upload" && key != "name" && key != "settings")
+      return std::unexpected(invalid(fmt::format("params.{}: unknown parameter", key)));
+  if (auto it = params.find("name"); it != params.end()) {
+    if (!it->is_string()) return std::unexpected(invalid("params.name: expected a string"));
+    r.name = it->get<std::string>();
+  }
+  if (auto it = params.find("settings"); it != params.end()) r.settings = *it;
+  // Checked before an upload is taken: a mistyped setting leaves the upload for the next try.
+  if (auto args = plan_args_from_settings(r.settings); !args) return std::unexpected(invalid(args.error()));
+  if (params.contains("upload")) {
+    auto id = string_param(params, "upload");
+    if (!id) return std::unexpected(id.error());
+    auto file = uploads.take(*id);
+    if (!file) return std::unexpected(file.error());
+    r.model_path = file->string();
+    r.move_into_job = true;
+  } else {
+    auto model = string_param(params, "model");
+    if (!model) return std::unexpected(model.error());
+    r.model_path = *model;
+  }
+  return job_result(jobs.submit(std::move(r)));
+}
+
+// job.*: one job each, named by params.job.
+void add_job_methods(std::map<std::string, Method>& m, JobManager& jobs, Uploads& uploads) {
+  m["job.submit"] = [&jobs, &uploads](const Json& params, ClientContext&) { return submit_job(jobs, uploads, params); };
   m["job.list"] = [&jobs](const Json&, ClientContext&) -> RpcResult {
     Json list = Json::array();
     for (const JobRecord& j : jobs.list())
@@ -153,7 +147,7 @@ RpcServer::Handler make_api_handler(JobManager& jobs, Uploads& uploads, ServerIn
                       {"sheets", j.sheets.size()}, {"error", j.error}, {"created_unix_ms", j.created_unix_ms}});
     return list;
   };
-  auto with_job = [&jobs](std::function<std::expected<JobRecord, JobError>(const std::string&, const Json&)> f) {
+  auto with_job = [](std::function<std::expected<JobRecord, JobError>(const std::string&, const Json&)> f) {
     return [f](const Json& params, ClientContext&) -> RpcResult {
       auto p = object_params(params);
       if (!p) return std::unexpected(p.error());
@@ -170,6 +164,10 @@ RpcServer::Handler make_api_handler(JobManager& jobs, Uploads& uploads, ServerIn
     if (!sheet) return std::unexpected(job_error(JobErrorKind::bad_request, sheet.error().message));
     return jobs.confirm_sheet(id, *sheet);
   });
+}
+
+// machine.*: the machine, whichever job has it.
+void add_machine_methods(std::map<std::string, Method>& m, JobManager& jobs) {
   m["machine.status"] = [&jobs](const Json&, ClientContext&) -> RpcResult { return jobs.machine_status(); };
   m["machine.hold"] = [&jobs](const Json&, ClientContext&) -> RpcResult { return machine_result(jobs.hold()); };
   m["machine.resume"] = [&jobs](const Json&, ClientContext&) -> RpcResult { return machine_result(jobs.resume_motion()); };
@@ -178,7 +176,24 @@ RpcServer::Handler make_api_handler(JobManager& jobs, Uploads& uploads, ServerIn
     if (params.is_object() && params.contains("reason") && params["reason"].is_string()) why = params["reason"];
     return machine_result(jobs.abort(why));
   };
+}
 
+}  // namespace
+
+RpcServer::Handler make_api_handler(JobManager& jobs, Uploads& uploads, ServerInfo info) {
+  auto methods = std::make_shared<std::map<std::string, Method>>();
+  auto& m = *methods;
+  m["server.info"] = [info](const Json&, ClientContext&) -> RpcResult {
+    return Json{{"name", "laminad"}, {"version", info.version}, {"machine", info.machine}, {"state_dir", info.state_dir},
+                {"api", 1}};
+  };
+  m["server.subscribe"] = [](const Json&, ClientContext& client) -> RpcResult {
+    client.subscribed = true;
+    return Json{{"subscribed", true}, {"notifications", {"notify_job_progress", "notify_machine_status"}}};
+  };
+  add_upload_methods(m, uploads);
+  add_job_methods(m, jobs, uploads);
+  add_machine_methods(m, jobs);
   return [methods](const RpcRequest& request, ClientContext& client) -> RpcResult {
     auto it = methods->find(request.method);
     if (it == methods->end())

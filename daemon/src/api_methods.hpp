@@ -1,7 +1,7 @@
 #pragma once
 // The JSON-RPC methods of laminad (docs/api.md): parameter checking, the call into the
-// JobManager, and its errors mapped to JSON-RPC codes. Runs on the io thread; every method
-// returns quickly.
+// JobManager, and its errors mapped to JSON-RPC codes. Runs on the RPC worker thread (the four
+// inline methods on the io thread: rpc_server.hpp); every method returns quickly.
 #include <string>
 
 #include "job_manager.hpp"

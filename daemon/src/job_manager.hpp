@@ -1,7 +1,8 @@
 #pragma once
 // The jobs of the cell and their state machine (docs/api.md "Job states"). Called from the RPC
-// handlers on the io thread (every public method returns quickly), it plans on worker threads
-// (lamina plan as a child process) and cuts on one cutting thread through the MachineSession.
+// handlers — on the RPC worker thread, the four inline methods on the io thread — and every
+// public method returns quickly; it plans on worker threads (lamina plan as a child process)
+// and cuts on one cutting thread through the MachineSession.
 // Every state change is written to the JobStore before it is announced.
 #include <atomic>
 #include <condition_variable>
