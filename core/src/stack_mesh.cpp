@@ -343,42 +343,18 @@ void keep_needed_rings(std::vector<Rings>& rings, std::vector<double>& heights) 
   heights = std::move(kept_heights);
 }
 
-void build_group(const LayerPlan& layer, const OutlineGroup& group, const std::vector<double>& all_heights,
-                 StackShells& shells) {
-  std::vector<const LayerOutline*> outlines{&layer.outlines[static_cast<std::size_t>(group.outer)]};
-  for (int h : group.holes) outlines.push_back(&layer.outlines[static_cast<std::size_t>(h)]);
-  const std::size_t nr = outlines.size();
-  std::vector<std::vector<std::size_t>> order(nr);
-  Rings base(nr);
-  for (std::size_t r = 0; r < nr; ++r) {
-    order[r] = station_order(*outlines[r], r > 0);
-    for (std::size_t i : order[r]) base[r].push_back(outlines[r]->stations[i].base_mm);
-  }
-  auto raw_rings = [&](double z) {
-    const double t = layer_t(layer, z);
-    Rings rings(nr);
-    for (std::size_t r = 0; r < nr; ++r) {
-      rings[r].reserve(order[r].size());
-      for (std::size_t i : order[r]) {
-        const CutStation& st = outlines[r]->stations[i];
-        rings[r].push_back(st.base_mm + station_offset(*outlines[r], i, t) * st.normal);
-      }
-    }
-    return rings;
-  };
-
-  std::size_t nk = all_heights.size();
-  std::vector<double> heights = all_heights;
-  std::vector<Rings> raw(nk), clean(nk);
+// Every height's rings pulled back where they tangle: from the clean height nearest the middle
+// (or, with none, the middle one clamped onto the base) outwards, each onto its neighbour.
+std::vector<Rings> untangled(const std::vector<Rings>& raw, const Rings& base) {
+  const std::size_t nk = raw.size();
+  std::vector<Rings> clean(nk);
   Marks marks;
   std::size_t seed = nk;
   const double middle = 0.5 * static_cast<double>(nk - 1);
-  for (std::size_t k = 0; k < nk; ++k) {
-    raw[k] = raw_rings(heights[k]);
+  for (std::size_t k = 0; k < nk; ++k)
     if (!find_tangles(raw[k], base, marks) &&
         (seed == nk || std::abs(static_cast<double>(k) - middle) < std::abs(static_cast<double>(seed) - middle)))
       seed = k;
-  }
   if (seed == nk) {
     seed = nk / 2;
     clean[seed] = clamp_rings(raw[seed], base, base);
@@ -387,35 +363,37 @@ void build_group(const LayerPlan& layer, const OutlineGroup& group, const std::v
   }
   for (std::size_t k = seed + 1; k < nk; ++k) clean[k] = clamp_rings(raw[k], clean[k - 1], base);
   for (std::size_t k = seed; k-- > 0;) clean[k] = clamp_rings(raw[k], clean[k + 1], base);
-  keep_needed_rings(clean, heights);
-  nk = heights.size();
+  return clean;
+}
 
-  // Vertices: height by height, ring by ring.
+// Vertices, walls and caps of one group: its rings at each height, `sizes` points each.
+void add_group_mesh(const std::vector<Rings>& clean, const std::vector<double>& heights,
+                    const std::vector<std::size_t>& sizes, StackShells& shells) {
+  const std::size_t nk = heights.size(), nr = sizes.size();
   std::size_t per_height = 0;
   std::vector<std::size_t> ring_start(nr);
   for (std::size_t r = 0; r < nr; ++r) {
     ring_start[r] = per_height;
-    per_height += base[r].size();
+    per_height += sizes[r];
   }
+  // Vertices: height by height, ring by ring.
   const std::size_t first = shells.vertices.size();
   shells.vertices.reserve(first + nk * per_height);
   for (std::size_t k = 0; k < nk; ++k)
     for (std::size_t r = 0; r < nr; ++r)
       for (const auto& p : clean[k][r]) shells.vertices.emplace_back(p.x(), p.y(), heights[k]);
   auto v = [&](std::size_t k, std::size_t r, std::size_t i) {
-    return static_cast<std::int32_t>(first + k * per_height + ring_start[r] + i % base[r].size());
+    return static_cast<std::int32_t>(first + k * per_height + ring_start[r] + i % sizes[r]);
   };
-
   // Walls: outer rings counter-clockwise and holes clockwise seen from above, so (along the ring)
   // × up points out of the material in both.
   for (std::size_t r = 0; r < nr; ++r)
     for (std::size_t k = 0; k + 1 < nk; ++k)
-      for (std::size_t i = 0; i < base[r].size(); ++i) {
+      for (std::size_t i = 0; i < sizes[r]; ++i) {
         const std::int32_t a = v(k, r, i), b = v(k, r, i + 1), c = v(k + 1, r, i + 1), d = v(k + 1, r, i);
         shells.faces.push_back({a, b, c});
         shells.faces.push_back({a, c, d});
       }
-
   // Caps, on exactly the ring vertices (the triangulation numbers outer then holes, as above).
   for (const std::size_t k : {nk - 1, std::size_t{0}}) {
     const Rings& rings = clean[k];
@@ -430,6 +408,39 @@ void build_group(const LayerPlan& layer, const OutlineGroup& group, const std::v
     }
   }
   ++shells.shells;
+}
+
+void build_group(const LayerPlan& layer, const OutlineGroup& group, const std::vector<double>& all_heights,
+                 StackShells& shells) {
+  std::vector<const LayerOutline*> outlines{&layer.outlines[static_cast<std::size_t>(group.outer)]};
+  for (int h : group.holes) outlines.push_back(&layer.outlines[static_cast<std::size_t>(h)]);
+  const std::size_t nr = outlines.size();
+  std::vector<std::vector<std::size_t>> order(nr);
+  Rings base(nr);
+  std::vector<std::size_t> sizes(nr);
+  for (std::size_t r = 0; r < nr; ++r) {
+    order[r] = station_order(*outlines[r], r > 0);
+    for (std::size_t i : order[r]) base[r].push_back(outlines[r]->stations[i].base_mm);
+    sizes[r] = base[r].size();
+  }
+  auto raw_rings = [&](double z) {
+    const double t = layer_t(layer, z);
+    Rings rings(nr);
+    for (std::size_t r = 0; r < nr; ++r) {
+      rings[r].reserve(order[r].size());
+      for (std::size_t i : order[r]) {
+        const CutStation& st = outlines[r]->stations[i];
+        rings[r].push_back(st.base_mm + station_offset(*outlines[r], i, t) * st.normal);
+      }
+    }
+    return rings;
+  };
+  std::vector<double> heights = all_heights;
+  std::vector<Rings> raw(heights.size());
+  for (std::size_t k = 0; k < heights.size(); ++k) raw[k] = raw_rings(heights[k]);
+  std::vector<Rings> clean = untangled(raw, base);
+  keep_needed_rings(clean, heights);
+  add_group_mesh(clean, heights, sizes, shells);
 }
 
 }  // namespace

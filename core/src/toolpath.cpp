@@ -172,6 +172,51 @@ class SheetBuilder {
     return {};
   }
 
+  // A trimming pass (every pass before the freeing one): only where its lines differ from the
+  // freeing pass's, as runs with one shared line on either side; a pass that differs nearly all
+  // round is opened at the microjoints, or at one bridge where it is thinnest.
+  std::expected<void, Error> cut_trim_pass(const LayerOutline& outline, const std::vector<CompensatedPass>& passes,
+                                           std::size_t pi, const std::vector<double>& tabs_u, double gap, Target t) {
+    const CutPass& pass = outline.passes[pi];
+    const CutPass& fin = outline.passes.back();
+    const std::size_t n = pass.lines.size();
+    std::vector<bool> differs(n);  // in cutting order
+    std::vector<double> sliver(n);
+    int count = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::size_t s = static_cast<std::size_t>(passes[pi].station_of[i]);
+      const double d = std::max((pass.lines[s].top_mm - fin.lines[s].top_mm).norm(),
+                                (pass.lines[s].bottom_mm - fin.lines[s].bottom_mm).norm());
+      sliver[i] = d;
+      differs[i] = d > kSameLineMm;
+      count += differs[i];
+    }
+    if (count == 0) return {};  // the same cut as the freeing pass: nothing to trim
+    count += join_short_gaps(passes[pi], differs);
+    if (count >= static_cast<int>(n) - 1) {
+      std::vector<double> bridges = tabs_u;
+      if (bridges.empty())
+        bridges.push_back(static_cast<double>(std::min_element(sliver.begin(), sliver.end()) - sliver.begin()));
+      return cut_between(passes[pi], bridges, gap, t, false);
+    }
+    std::size_t start = 0;
+    while (differs[start]) ++start;  // a line that does not differ (count < n)
+    for (std::size_t k = 0; k < n;) {
+      const std::size_t i = (start + k) % n;
+      if (!differs[i]) {
+        ++k;
+        continue;
+      }
+      std::size_t len = 0;
+      while (k + len < n && differs[(start + k + len) % n]) ++len;
+      std::vector<PathPoint> run;
+      for (std::size_t j = 0; j < len + 2; ++j) run.push_back(passes[pi].points[(i + n - 1 + j) % n]);
+      emit_contour(std::move(run), passes[pi].points, t, false, false);
+      k += len;
+    }
+    return {};
+  }
+
   std::expected<void, Error> cut_outline(const SheetFrame& frame, const LayerPlan& layer, Target t) {
     const LayerOutline& outline = layer.outlines[static_cast<std::size_t>(t.outline)];
     const std::string where = fmt::format("sheet {}, part {}, outline {}", sheet_.index,
@@ -203,47 +248,7 @@ class SheetBuilder {
 
     for (std::size_t pi = 0; pi < last; ++pi) {
       t.pass = static_cast<int>(pi);
-      const CutPass& pass = outline.passes[pi];
-      const CutPass& fin = outline.passes[last];
-      const std::size_t n = pass.lines.size();
-      std::vector<bool> differs(n);  // in cutting order
-      std::vector<double> sliver(n);
-      int count = 0;
-      for (std::size_t i = 0; i < n; ++i) {
-        const std::size_t s = static_cast<std::size_t>(passes[pi].station_of[i]);
-        const double d = std::max((pass.lines[s].top_mm - fin.lines[s].top_mm).norm(),
-                                  (pass.lines[s].bottom_mm - fin.lines[s].bottom_mm).norm());
-        sliver[i] = d;
-        differs[i] = d > kSameLineMm;
-        count += differs[i];
-      }
-      if (count == 0) continue;  // the same cut as the freeing pass: nothing to trim
-      count += join_short_gaps(passes[pi], differs);
-      if (count >= static_cast<int>(n) - 1) {
-        // Would go all the way round: open at the microjoints, or at one bridge where it is thinnest.
-        std::vector<double> bridges = tabs_u;
-        if (bridges.empty())
-          bridges.push_back(static_cast<double>(std::min_element(sliver.begin(), sliver.end()) - sliver.begin()));
-        if (auto ok = cut_between(passes[pi], bridges, gap, t, false); !ok) return ok;
-        continue;
-      }
-      // Runs of differing lines, each with one shared line on either side, so the cut starts and
-      // ends on the freeing pass's surface.
-      std::size_t start = 0;
-      while (differs[start]) ++start;  // a line that does not differ (count < n)
-      for (std::size_t k = 0; k < n;) {
-        const std::size_t i = (start + k) % n;
-        if (!differs[i]) {
-          ++k;
-          continue;
-        }
-        std::size_t len = 0;
-        while (k + len < n && differs[(start + k + len) % n]) ++len;
-        std::vector<PathPoint> run;
-        for (std::size_t j = 0; j < len + 2; ++j) run.push_back(passes[pi].points[(i + n - 1 + j) % n]);
-        emit_contour(std::move(run), passes[pi].points, t, false, false);
-        k += len;
-      }
+      if (auto ok = cut_trim_pass(outline, passes, pi, tabs_u, gap, t); !ok) return ok;
     }
     t.pass = static_cast<int>(last);
     if (tabs_u.empty()) {

@@ -36,18 +36,17 @@ lamina::sim::AxisValues parse_axes(const std::string& text, const char* flag) {
   return out;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  using namespace lamina::sim;
-  SimOptions o;
-  CLI::App app{"lamina-sim: a simulated waterjet cell (CNC on a PTY/TCP, PLC on Modbus TCP)"};
+// Options that are not fields of SimOptions as typed: applied after parsing (apply_options).
+struct CliExtras {
   std::string machine_file, soft_min, soft_max;
   std::optional<std::uint64_t> drop_ok, alarm_at_line;
   std::optional<double> heartbeat_timeout_ms;
   std::size_t rx_buffer = 0, planner_blocks = 0;
   bool no_soft_limits = false;
   std::string on_open = "quiet";
+};
+
+void add_cell_options(CLI::App& app, lamina::sim::SimOptions& o, CliExtras& x) {
   app.add_option("--personality", o.personality, "grbl (character counting) or xonxoff (Fanuc drip feed)")
       ->check(CLI::IsMember({"grbl", "xonxoff"}));
   app.add_option("--link", o.link_path, "make a PTY and symlink its slave here");
@@ -57,55 +56,72 @@ int main(int argc, char** argv) {
   app.add_option("--log", o.log_path, "execution log, JSON lines");
   app.add_option("--baud", o.baud, "emulated line speed, 8N1 (default 115200)");
   app.add_option("--time-scale", o.time_scale, "run the machine K times faster than real time");
-  app.add_option("--on-open", on_open,
+  app.add_option("--on-open", x.on_open,
                  "when a client opens the port: quiet (default: native-USB grblHAL says nothing), banner, or reset (a classic Grbl's DTR reset)")
       ->check(CLI::IsMember({"banner", "reset", "quiet"}));
-  app.add_option("--rx-buffer", rx_buffer, "controller receive buffer in bytes (grbl 1024, classic Grbl 128)");
-  app.add_option("--planner-blocks", planner_blocks, "planner queue length in blocks (default 100)");
-  app.add_option("--machine", machine_file, "TOML file: soft limits, rapids, feeds, jet M-codes");
-  app.add_option("--soft-min", soft_min, "soft limits, lower: X,Y,Z,A,C (mm, deg)");
-  app.add_option("--soft-max", soft_max, "soft limits, upper: X,Y,Z,A,C (mm, deg)");
-  app.add_flag("--no-soft-limits", no_soft_limits, "do not check soft limits");
-  app.add_option("--heartbeat-timeout", heartbeat_timeout_ms, "PLC heartbeat watchdog in ms (0 = off)");
+  app.add_option("--rx-buffer", x.rx_buffer, "controller receive buffer in bytes (grbl 1024, classic Grbl 128)");
+  app.add_option("--planner-blocks", x.planner_blocks, "planner queue length in blocks (default 100)");
+  app.add_option("--machine", x.machine_file, "TOML file: soft limits, rapids, feeds, jet M-codes");
+  app.add_option("--soft-min", x.soft_min, "soft limits, lower: X,Y,Z,A,C (mm, deg)");
+  app.add_option("--soft-max", x.soft_max, "soft limits, upper: X,Y,Z,A,C (mm, deg)");
+  app.add_flag("--no-soft-limits", x.no_soft_limits, "do not check soft limits");
+  app.add_option("--heartbeat-timeout", x.heartbeat_timeout_ms, "PLC heartbeat watchdog in ms (0 = off)");
   app.add_option("--pressure-ramp", o.plc.pressure_ramp_s, "seconds for the pump to reach its set point");
-  // Faults.
-  app.add_option("--drop-ok", drop_ok, "never send the k-th ok (1-based)");
+}
+
+void add_fault_options(CLI::App& app, lamina::sim::SimOptions& o, CliExtras& x) {
+  app.add_option("--drop-ok", x.drop_ok, "never send the k-th ok (1-based)");
   app.add_option("--garble", o.faults.garble_probability, "flip a bit in each received byte with probability P");
   app.add_option("--seed", o.faults.garble_seed, "seed for --garble");
   app.add_option("--unplug-at-line", o.faults.unplug_at_line, "close the port once N lines were received");
   app.add_option("--unplug-at", o.faults.unplug_at_s, "close the port at simulated time T (s)");
   app.add_option("--replug-after", o.faults.replug_after_ms, "reopen the port this many ms after an unplug");
-  app.add_option("--alarm-at-line", alarm_at_line, "ALARM:1 when block N starts executing");
+  app.add_option("--alarm-at-line", x.alarm_at_line, "ALARM:1 when block N starts executing");
   app.add_option("--estop-at", o.faults.estop_at_s, "press the e-stop at simulated time T (s)");
   app.add_option("--pressure-drop-at", o.faults.pressure_drop_at_s, "pump pressure drops at simulated time T (s)");
   app.add_option("--stall-at", o.faults.stall_at_s, "stop draining the receive buffer at simulated time T (s)");
   app.add_option("--stall-for", o.faults.stall_ms, "… for this many ms (wall clock)");
+}
+
+// The extras into the options; throws std::runtime_error naming the option that is wrong.
+void apply_options(lamina::sim::SimOptions& o, const CliExtras& x) {
+  using namespace lamina::sim;
+  if (!x.machine_file.empty()) apply_machine_file(x.machine_file, o);
+  o.on_open = x.on_open == "reset" ? OnOpen::reset : x.on_open == "banner" ? OnOpen::banner : OnOpen::quiet;
+  if (x.rx_buffer) o.grbl.rx_buffer_bytes = o.xonxoff.buffer_bytes = x.rx_buffer;
+  if (o.personality == "xonxoff") {  // water marks follow the buffer: DC3 at ¾, DC1 at ¼
+    o.xonxoff.high_water_bytes = o.xonxoff.buffer_bytes * 3 / 4;
+    o.xonxoff.low_water_bytes = o.xonxoff.buffer_bytes / 4;
+    // A Fanuc reads G4 P in milliseconds and carries an O program number.
+    o.machine.parse.dwell_p_unit_s = 0.001;
+    o.machine.parse.accept_program_number = true;
+  }
+  if (x.planner_blocks) o.machine.planner_blocks = x.planner_blocks;
+  if (!x.soft_min.empty()) o.machine.soft_min = parse_axes(x.soft_min, "--soft-min");
+  if (!x.soft_max.empty()) o.machine.soft_max = parse_axes(x.soft_max, "--soft-max");
+  if (x.no_soft_limits) o.machine.soft_limits = false;
+  if (x.heartbeat_timeout_ms) o.plc.heartbeat_timeout_s = *x.heartbeat_timeout_ms / 1000.0;
+  // The PLC runs on simulated time, but its watchdog supervises a host that runs on the wall
+  // clock (like the baud): the timeout is wall milliseconds, so it stretches with the scale.
+  o.plc.heartbeat_timeout_s *= o.time_scale;
+  if (x.drop_ok) o.grbl.faults.drop_ok_index = o.xonxoff.faults.drop_ok_index = x.drop_ok;
+  if (x.alarm_at_line) o.machine.alarm_at_seq = x.alarm_at_line;
+  if (o.faults.garble_probability < 0 || o.faults.garble_probability > 1)
+    throw std::runtime_error("--garble: a probability in [0, 1]");
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace lamina::sim;
+  SimOptions o;
+  CliExtras x;
+  CLI::App app{"lamina-sim: a simulated waterjet cell (CNC on a PTY/TCP, PLC on Modbus TCP)"};
+  add_cell_options(app, o, x);
+  add_fault_options(app, o, x);
   CLI11_PARSE(app, argc, argv);
-
   try {
-    if (!machine_file.empty()) apply_machine_file(machine_file, o);
-    o.on_open = on_open == "reset" ? OnOpen::reset : on_open == "banner" ? OnOpen::banner : OnOpen::quiet;
-    if (rx_buffer) o.grbl.rx_buffer_bytes = o.xonxoff.buffer_bytes = rx_buffer;
-    if (o.personality == "xonxoff") {  // water marks follow the buffer: DC3 at ¾, DC1 at ¼
-      o.xonxoff.high_water_bytes = o.xonxoff.buffer_bytes * 3 / 4;
-      o.xonxoff.low_water_bytes = o.xonxoff.buffer_bytes / 4;
-      // A Fanuc reads G4 P in milliseconds and carries an O program number.
-      o.machine.parse.dwell_p_unit_s = 0.001;
-      o.machine.parse.accept_program_number = true;
-    }
-    if (planner_blocks) o.machine.planner_blocks = planner_blocks;
-    if (!soft_min.empty()) o.machine.soft_min = parse_axes(soft_min, "--soft-min");
-    if (!soft_max.empty()) o.machine.soft_max = parse_axes(soft_max, "--soft-max");
-    if (no_soft_limits) o.machine.soft_limits = false;
-    if (heartbeat_timeout_ms) o.plc.heartbeat_timeout_s = *heartbeat_timeout_ms / 1000.0;
-    // The PLC runs on simulated time, but its watchdog supervises a host that runs on the wall
-    // clock (like the baud): the timeout is wall milliseconds, so it stretches with the scale.
-    o.plc.heartbeat_timeout_s *= o.time_scale;
-    if (drop_ok) o.grbl.faults.drop_ok_index = o.xonxoff.faults.drop_ok_index = drop_ok;
-    if (alarm_at_line) o.machine.alarm_at_seq = alarm_at_line;
-    if (o.faults.garble_probability < 0 || o.faults.garble_probability > 1)
-      throw std::runtime_error("--garble: a probability in [0, 1]");
-
+    apply_options(o, x);
     std::signal(SIGTERM, on_signal);
     std::signal(SIGINT, on_signal);
     std::signal(SIGPIPE, SIG_IGN);
