@@ -61,7 +61,7 @@ void add_upload_methods(std::map<std::string, Method>& m, Uploads& uploads) {
     if (!params.contains("size") || !params["size"].is_number_unsigned())
       return std::unexpected(invalid("params.size: expected the file's size in bytes"));
     auto id = uploads.begin(*name, params["size"].get<std::uint64_t>());
-    if (!id) return std::unexpected(id.error());
+    if (!id) return std::unexpected(rpc_error(id.error()));
     return Json{{"upload", *id}};
   };
   m["upload.chunk"] = [&uploads](const Json& params, ClientContext&) -> RpcResult {
@@ -74,7 +74,7 @@ void add_upload_methods(std::map<std::string, Method>& m, Uploads& uploads) {
     if (!params.contains("offset") || !params["offset"].is_number_unsigned())
       return std::unexpected(invalid("params.offset: expected a byte offset"));
     auto received = uploads.chunk(*id, params["offset"].get<std::uint64_t>(), *data);
-    if (!received) return std::unexpected(received.error());
+    if (!received) return std::unexpected(rpc_error(received.error()));
     return Json{{"received", *received}};
   };
   m["upload.cancel"] = [&uploads](const Json& params, ClientContext&) -> RpcResult {
@@ -82,7 +82,7 @@ void add_upload_methods(std::map<std::string, Method>& m, Uploads& uploads) {
     if (!p) return std::unexpected(p.error());
     auto id = string_param(params, "upload");
     if (!id) return std::unexpected(id.error());
-    if (auto r = uploads.cancel(*id); !r) return std::unexpected(r.error());
+    if (auto r = uploads.cancel(*id); !r) return std::unexpected(rpc_error(r.error()));
     return Json{{"cancelled", *id}};
   };
 }
@@ -126,7 +126,7 @@ RpcResult submit_job(JobManager& jobs, Uploads& uploads, const Json& params) {
     auto id = string_param(params, "upload");
     if (!id) return std::unexpected(id.error());
     auto file = uploads.take(*id);
-    if (!file) return std::unexpected(file.error());
+    if (!file) return std::unexpected(rpc_error(file.error()));
     r.model_path = file->string();
     r.move_into_job = true;
   } else {

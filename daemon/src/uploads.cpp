@@ -13,7 +13,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-RpcError invalid(std::string message) { return RpcError{rpc_code::invalid_params, std::move(message), nullptr}; }
+JobError invalid(std::string message) { return JobError{JobErrorKind::bad_request, std::move(message)}; }
 
 bool model_extension(const std::string& name) {
   const auto dot = name.rfind('.');
@@ -77,7 +77,7 @@ Uploads::Uploads(fs::path dir, UploadLimits limits) : dir_(std::move(dir)), limi
   fs::create_directories(dir_, ec);
 }
 
-std::expected<std::string, RpcError> Uploads::begin(const std::string& file_name, std::uint64_t size_bytes,
+std::expected<std::string, JobError> Uploads::begin(const std::string& file_name, std::uint64_t size_bytes,
                                                     Clock::time_point now) {
   const bool control_char = std::any_of(file_name.begin(), file_name.end(),
                                         [](char c) { return static_cast<unsigned char>(c) < 0x20 || c == 0x7F; });
@@ -90,15 +90,14 @@ std::expected<std::string, RpcError> Uploads::begin(const std::string& file_name
   std::lock_guard lock(mutex_);
   expire(now);
   if (open_.size() >= limits_.max_open)
-    return std::unexpected(RpcError{rpc_code::invalid_state,
+    return std::unexpected(JobError{JobErrorKind::wrong_state,
                                     fmt::format("{} uploads are unfinished already (each is dropped after {} s without "
                                                 "a chunk, or by upload.cancel)",
-                                                open_.size(), limits_.idle_s),
-                                    nullptr});
+                                                open_.size(), limits_.idle_s)});
   const std::string id = random_id();
   Upload u{dir_ / (id + "-" + file_name), size_bytes, 0, now};
   std::ofstream create(u.path, std::ios::binary | std::ios::trunc);
-  if (!create) return std::unexpected(RpcError{rpc_code::storage_error, fmt::format("cannot create {}", u.path.string()), nullptr});
+  if (!create) return std::unexpected(JobError{JobErrorKind::storage, fmt::format("cannot create {}", u.path.string())});
   open_[id] = u;
   return id;
 }
@@ -116,7 +115,7 @@ void Uploads::expire(Clock::time_point now) {
   }
 }
 
-std::expected<Uploads::Upload*, RpcError> Uploads::find(const std::string& id, Clock::time_point now) {
+std::expected<Uploads::Upload*, JobError> Uploads::find(const std::string& id, Clock::time_point now) {
   expire(now);
   auto it = open_.find(id);
   // The same answer for an id that never was, expired or was taken: the id is all a client has.
@@ -124,7 +123,7 @@ std::expected<Uploads::Upload*, RpcError> Uploads::find(const std::string& id, C
   return &it->second;
 }
 
-std::expected<std::uint64_t, RpcError> Uploads::chunk(const std::string& id, std::uint64_t offset, std::string_view base64,
+std::expected<std::uint64_t, JobError> Uploads::chunk(const std::string& id, std::uint64_t offset, std::string_view base64,
                                                       Clock::time_point now) {
   auto data = decode_base64(base64);
   if (!data) return std::unexpected(invalid("params.data: not base64"));
@@ -141,13 +140,13 @@ std::expected<std::uint64_t, RpcError> Uploads::chunk(const std::string& id, std
   std::fstream f(u.path, std::ios::binary | std::ios::in | std::ios::out);
   f.seekp(static_cast<std::streamoff>(offset));
   f.write(data->data(), static_cast<std::streamsize>(data->size()));
-  if (!f) return std::unexpected(RpcError{rpc_code::storage_error, fmt::format("writing {} failed", u.path.string()), nullptr});
+  if (!f) return std::unexpected(JobError{JobErrorKind::storage, fmt::format("writing {} failed", u.path.string())});
   u.received = std::max(u.received, offset + data->size());
   u.last_activity = now;
   return u.received;
 }
 
-std::expected<fs::path, RpcError> Uploads::take(const std::string& id, Clock::time_point now) {
+std::expected<fs::path, JobError> Uploads::take(const std::string& id, Clock::time_point now) {
   std::lock_guard lock(mutex_);
   auto found = find(id, now);
   if (!found) return std::unexpected(found.error());
@@ -158,7 +157,7 @@ std::expected<fs::path, RpcError> Uploads::take(const std::string& id, Clock::ti
   return p;
 }
 
-std::expected<void, RpcError> Uploads::cancel(const std::string& id) {
+std::expected<void, JobError> Uploads::cancel(const std::string& id) {
   std::lock_guard lock(mutex_);
   auto it = open_.find(id);
   if (it == open_.end()) return std::unexpected(invalid(fmt::format("params.upload: no upload {} (unknown, expired or taken)", id)));

@@ -18,7 +18,9 @@
 #include <string>
 #include <string_view>
 
-#include "lamina/daemon/rpc_server.hpp"
+#include "job_error.hpp"
+
+#include <optional>
 
 namespace lamina::daemon {
 
@@ -33,15 +35,15 @@ class Uploads {
  public:
   using Clock = std::chrono::steady_clock;
   Uploads(std::filesystem::path dir, UploadLimits limits = {});
-  std::expected<std::string, RpcError> begin(const std::string& file_name, std::uint64_t size_bytes,
+  std::expected<std::string, JobError> begin(const std::string& file_name, std::uint64_t size_bytes,
                                              Clock::time_point now = Clock::now());
   // Returns the bytes received so far.
-  std::expected<std::uint64_t, RpcError> chunk(const std::string& id, std::uint64_t offset, std::string_view base64,
+  std::expected<std::uint64_t, JobError> chunk(const std::string& id, std::uint64_t offset, std::string_view base64,
                                                Clock::time_point now = Clock::now());
   // The complete file (the upload is forgotten; the caller moves or deletes the file).
-  std::expected<std::filesystem::path, RpcError> take(const std::string& id, Clock::time_point now = Clock::now());
+  std::expected<std::filesystem::path, JobError> take(const std::string& id, Clock::time_point now = Clock::now());
   // Drops an unfinished (or finished, not yet taken) upload and its file.
-  std::expected<void, RpcError> cancel(const std::string& id);
+  std::expected<void, JobError> cancel(const std::string& id);
   std::size_t open_count() const;
 
  private:
@@ -51,7 +53,7 @@ class Uploads {
     Clock::time_point last_activity;
   };
   void expire(Clock::time_point now);  // under mutex_
-  std::expected<Upload*, RpcError> find(const std::string& id, Clock::time_point now);  // under mutex_
+  std::expected<Upload*, JobError> find(const std::string& id, Clock::time_point now);  // under mutex_
 
   std::filesystem::path dir_;
   UploadLimits limits_;
