@@ -291,22 +291,53 @@ class Fitter {
 
   // Largest distance in the profile plane between the cut edge and the surface, both ways.
   double deviation(const std::vector<Line>& lines) const {
+    const std::vector<Point> edge_pts = edge_polyline(lines);
+    const std::vector<Seg> surface = surface_segments();
+    double worst = 0.0;
+    for (const Point& e : edge_pts) {
+      double best = std::numeric_limits<double>::infinity();
+      for (const Seg& s : surface) best = std::min(best, dist_to_seg(e, s.a, s.b));
+      if (std::isfinite(best)) worst = std::max(worst, best);
+    }
+    for (const Point& p : present_) {
+      double best = std::numeric_limits<double>::infinity();
+      for (std::size_t i = 0; i + 1 < edge_pts.size(); ++i) best = std::min(best, dist_to_seg(p, edge_pts[i], edge_pts[i + 1]));
+      if (edge_pts.size() == 1) best = dist_to_seg(p, edge_pts[0], edge_pts[0]);
+      worst = std::max(worst, best);
+    }
+    return worst;
+  }
+
+  struct Seg {
+    Point a, b;
+  };
+
+  static double dist_to_seg(const Point& p, const Point& a, const Point& b) {
+    const double dz = b.z - a.z, du = b.u - a.u;
+    const double len2 = dz * dz + du * du;
+    double t = len2 > 0 ? ((p.z - a.z) * dz + (p.u - a.u) * du) / len2 : 0.0;
+    t = std::clamp(t, 0.0, 1.0);
+    const double ez = a.z + t * dz - p.z, eu = a.u + t * du - p.u;
+    return std::sqrt(ez * ez + eu * eu);
+  }
+
+  // The edge the lines leave (the innermost of them at each height) as a polyline: layer faces
+  // and sample heights, plus the corner where the active line changes between two of them
+  // (O(heights × lines), not all pairs of lines).
+  std::vector<Point> edge_polyline(const std::vector<Line>& lines) const {
     auto edge = [&](double z) {
       double u = std::numeric_limits<double>::infinity();
       for (const Line& l : lines) u = std::min(u, l.at(z, zb_));
       return u;
     };
-    // The edge as a polyline: layer faces and sample heights, plus the corner where the active
-    // line changes between two of them (O(heights × lines), not all pairs of lines).
     std::vector<double> zs{zb_, zt_};
     for (const auto& s : all_) zs.push_back(std::clamp(s.z_mm, zb_, zt_));
     std::sort(zs.begin(), zs.end());
     zs.erase(std::unique(zs.begin(), zs.end(), [](double a, double b) { return std::abs(a - b) < 1e-12; }), zs.end());
     auto active = [&](double z) {
       std::size_t best = 0;
-      for (std::size_t i = 1; i < lines.size(); ++i) {
+      for (std::size_t i = 1; i < lines.size(); ++i)
         if (lines[i].at(z, zb_) < lines[best].at(z, zb_)) best = i;
-      }
       return best;
     };
     std::vector<Point> edge_pts;
@@ -324,10 +355,14 @@ class Fitter {
       edge_pts.push_back({z, edge(z)});
       prev = a;
     }
+    return edge_pts;
+  }
 
-    // The surface as segments: neighbouring samples with material joined; where material stops
-    // (the surface turned horizontal between two sub-slices) a ledge runs inwards half-way.
-    struct Seg { Point a, b; };
+  // The surface as segments: neighbouring samples with material joined; where material stops
+  // (the surface turned horizontal between two sub-slices) a ledge runs inwards half-way.
+  // Sub-slices are read just inside the layer's faces: the surface continues to the face along
+  // its tangent.
+  std::vector<Seg> surface_segments() const {
     std::vector<Seg> surface;
     constexpr double kInward = 1e6;
     for (std::size_t i = 0; i < all_.size(); ++i) {
@@ -351,8 +386,6 @@ class Fitter {
       }
       if (present_.size() == 1) surface.push_back({p, p});
     }
-    // Sub-slices are read just inside the layer's faces: the surface continues to the face
-    // along its tangent.
     auto extend = [&](const ProfileSample& s, double z_face) {
       if (!s.present || std::abs(z_face - s.z_mm) > 0.05 * (zt_ - zb_)) return;
       const double m = std::isfinite(s.slope) ? std::clamp(s.slope, -1e3, 1e3) : 0.0;
@@ -362,27 +395,7 @@ class Fitter {
       extend(all_.front(), zb_);
       extend(all_.back(), zt_);
     }
-    auto dist_to_seg = [](const Point& p, const Point& a, const Point& b) {
-      const double dz = b.z - a.z, du = b.u - a.u;
-      const double len2 = dz * dz + du * du;
-      double t = len2 > 0 ? ((p.z - a.z) * dz + (p.u - a.u) * du) / len2 : 0.0;
-      t = std::clamp(t, 0.0, 1.0);
-      const double ez = a.z + t * dz - p.z, eu = a.u + t * du - p.u;
-      return std::sqrt(ez * ez + eu * eu);
-    };
-    double worst = 0.0;
-    for (const Point& e : edge_pts) {
-      double best = std::numeric_limits<double>::infinity();
-      for (const Seg& s : surface) best = std::min(best, dist_to_seg(e, s.a, s.b));
-      if (std::isfinite(best)) worst = std::max(worst, best);
-    }
-    for (const Point& p : present_) {
-      double best = std::numeric_limits<double>::infinity();
-      for (std::size_t i = 0; i + 1 < edge_pts.size(); ++i) best = std::min(best, dist_to_seg(p, edge_pts[i], edge_pts[i + 1]));
-      if (edge_pts.size() == 1) best = dist_to_seg(p, edge_pts[0], edge_pts[0]);
-      worst = std::max(worst, best);
-    }
-    return worst;
+    return surface;
   }
 
   std::span<const ProfileSample> all_;
