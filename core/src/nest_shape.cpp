@@ -72,26 +72,16 @@ ClipperLib::Polygon item_shape(const Part& part, double delta_mm) {
   return shape;
 }
 
-}  // namespace
-
-std::vector<PackedSheet> pack_shape(std::span<const Part> parts, std::span<const int> which, SheetSize size,
-                                    const NestParams& params, std::vector<int>& unplaced,
-                                    ShapePackDiagnostics* diagnostics) {
-  const double delta = 0.5 * params.spacing_mm + kSlackMm;
-  // The bin: sheet minus margin, grown by half the spacing (the items are grown by about as much).
-  const double grow = params.margin_mm - 0.5 * params.spacing_mm;
-  auto nm = [](double mm) { return static_cast<ClipperLib::cInt>(std::llround(mm * kClipperUnitsPerMm)); };
-  const ln::Box bin({nm(grow), nm(grow)}, {nm(size.length_mm - grow), nm(size.width_mm - grow)});
-
-  const double base = params.rotations_rad.front();
+// The items, each at the first listed rotation at which it fits the bin: libnest2d puts the
+// first item of a bin at its current rotation.
+std::vector<ln::Item> shape_items(std::span<const Part> parts, std::span<const int> which, double delta,
+                                  const ln::Box& bin, const std::vector<double>& rotations) {
   std::vector<ln::Item> items;
   items.reserve(which.size());
   for (int p : which) {
     items.emplace_back(item_shape(parts[p], delta));
-    // libnest2d puts the first item of a bin at its current rotation: start from the first listed
-    // rotation at which the part fits the sheet.
-    double start = base;
-    for (double a : params.rotations_rad) {
+    double start = rotations.front();
+    for (double a : rotations) {
       ln::Item probe = items.back();
       probe.rotation(a);
       const auto bb = probe.boundingBox();
@@ -102,31 +92,38 @@ std::vector<PackedSheet> pack_shape(std::span<const Part> parts, std::span<const
     }
     items.back().rotation(start);
   }
+  return items;
+}
 
-  ln::NestConfig<ln::NfpPlacer, ln::FirstFitSelection> cfg;
+// The pile placed so far, as the placer's callbacks see it.
+struct Pile {
+  ln::Box box;
+  bool any = false;
+};
+
+// Fill the sheet from one end: keep the pile short along x (the sheet's length), then low and to
+// the left. libnest2d checks that the pile's bounding box fits the bin and moves the pile into
+// the bin's bottom-left corner at the end.
+void configure_placer(ln::NestConfig<ln::NfpPlacer, ln::FirstFitSelection>& cfg, const NestParams& params,
+                      const ln::Box& bin, Pile& pile) {
   auto& pc = cfg.placer_config;
+  const double base = params.rotations_rad.front();
   pc.rotations.clear();
   for (double a : params.rotations_rad) pc.rotations.emplace_back(a - base);
   pc.alignment = ln::NfpPlacer::Config::Alignment::BOTTOM_LEFT;
   pc.starting_point = ln::NfpPlacer::Config::Alignment::BOTTOM_LEFT;
   pc.parallel = params.parallel;
   pc.accuracy = 0.65f;
-  // Fill the sheet from one end: keep the pile short along x (the sheet's length), then low and
-  // to the left. libnest2d checks that the pile's bounding box fits the bin and moves the pile
-  // into the bin's bottom-left corner at the end.
   const double len = static_cast<double>(bin.width());
   const double wid = static_cast<double>(bin.height());
-  ln::Box pile_box;
-  bool have_pile = false;
-  pc.before_packing = [&pile_box, &have_pile](const ln::nfp::Shapes<ClipperLib::Polygon>& merged,
-                                              const ln::_ItemGroup<ClipperLib::Polygon>&,
-                                              const ln::_ItemGroup<ClipperLib::Polygon>&) {
-    have_pile = !merged.empty();
-    if (have_pile) pile_box = ln::shapelike::boundingBox(merged);
+  pc.before_packing = [&pile](const ln::nfp::Shapes<ClipperLib::Polygon>& merged,
+                              const ln::_ItemGroup<ClipperLib::Polygon>&, const ln::_ItemGroup<ClipperLib::Polygon>&) {
+    pile.any = !merged.empty();
+    if (pile.any) pile.box = ln::shapelike::boundingBox(merged);
   };
-  pc.object_function = [&pile_box, &have_pile, len, wid](const ln::Item& item) {
+  pc.object_function = [&pile, len, wid](const ln::Item& item) {
     const ln::Box ib = item.boundingBox();
-    const ln::Box full = have_pile ? ln::shapelike::boundingBox(pile_box, ib) : ib;
+    const ln::Box full = pile.any ? ln::shapelike::boundingBox(pile.box, ib) : ib;
     // Positions whose pile would not fit the bin score worse than any that fits (libnest2d keeps
     // only the best local optimum of a no-fit polygon and drops it if it does not fit).
     const double over = std::max(0.0, static_cast<double>(full.width()) - len) / len +
@@ -136,7 +133,37 @@ std::vector<PackedSheet> pack_shape(std::span<const Part> parts, std::span<const
     const double x_low = static_cast<double>(ib.maxCorner().X - full.minCorner().X) / len;
     return x_extent + 0.1 * y_low + 0.01 * x_low + (over > 0.0 ? 10.0 + over : 0.0);
   };
+}
 
+// How far libnest2d's placed shape is from our placement of the raw one, at worst (mm).
+double transform_error_mm(const ln::Item& it, const Placement& pl) {
+  double worst = 0.0;
+  const auto& raw = it.rawShape().Contour;
+  const auto& placed = it.transformedShape().Contour;
+  for (std::size_t v = 0; v < raw.size() && v < placed.size(); ++v) {
+    const Eigen::Vector2d layer(static_cast<double>(raw[v].X) / kClipperUnitsPerMm,
+                                static_cast<double>(raw[v].Y) / kClipperUnitsPerMm);
+    const Eigen::Vector2d want(static_cast<double>(placed[v].X) / kClipperUnitsPerMm,
+                               static_cast<double>(placed[v].Y) / kClipperUnitsPerMm);
+    worst = std::max(worst, (place_point(pl, layer) - want).norm());
+  }
+  return worst;
+}
+
+}  // namespace
+
+std::vector<PackedSheet> pack_shape(std::span<const Part> parts, std::span<const int> which, SheetSize size,
+                                    const NestParams& params, std::vector<int>& unplaced,
+                                    ShapePackDiagnostics* diagnostics) {
+  const double delta = 0.5 * params.spacing_mm + kSlackMm;
+  // The bin: sheet minus margin, grown by half the spacing (the items are grown by about as much).
+  const double grow = params.margin_mm - 0.5 * params.spacing_mm;
+  auto nm = [](double mm) { return static_cast<ClipperLib::cInt>(std::llround(mm * kClipperUnitsPerMm)); };
+  const ln::Box bin({nm(grow), nm(grow)}, {nm(size.length_mm - grow), nm(size.width_mm - grow)});
+  std::vector<ln::Item> items = shape_items(parts, which, delta, bin, params.rotations_rad);
+  ln::NestConfig<ln::NfpPlacer, ln::FirstFitSelection> cfg;
+  Pile pile;
+  configure_placer(cfg, params, bin, pile);
   ln::nest(items, bin, 0, cfg);
 
   int bins = 0;
@@ -157,17 +184,8 @@ std::vector<PackedSheet> pack_shape(std::span<const Part> parts, std::span<const
     pl.offset_mm = Eigen::Vector2d(static_cast<double>(it.translation().X), static_cast<double>(it.translation().Y)) /
                    kClipperUnitsPerMm;
     out[static_cast<std::size_t>(it.binId())].placements.push_back(pl);
-    if (diagnostics) {
-      // The same map applied to the raw (untransformed) item must give libnest2d's shape.
-      const auto& raw = it.rawShape().Contour;
-      const auto& placed = it.transformedShape().Contour;
-      for (std::size_t v = 0; v < raw.size() && v < placed.size(); ++v) {
-        const Eigen::Vector2d layer(static_cast<double>(raw[v].X) / kClipperUnitsPerMm,
-                                    static_cast<double>(raw[v].Y) / kClipperUnitsPerMm);
-        const Eigen::Vector2d want(static_cast<double>(placed[v].X) / kClipperUnitsPerMm,
-                                   static_cast<double>(placed[v].Y) / kClipperUnitsPerMm);
-        worst = std::max(worst, (place_point(pl, layer) - want).norm());
-      }
+    if (diagnostics) {  // the same map applied to the raw (untransformed) item must give libnest2d's shape
+      worst = std::max(worst, transform_error_mm(it, pl));
       ++diagnostics->items;
     }
   }
