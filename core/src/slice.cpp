@@ -140,11 +140,8 @@ void drop_zero_length(Chain& chain, bool closed) {
   chain.points.resize(closed ? w : w + 1);
 }
 
-Slice slice_one(const Mesh& mesh, std::span<const std::int32_t> faces, double z,
-                const SliceParams& params, Scratch& s) {
-  Slice slice;
-  slice.z_mm = z;
-  collect_segments(mesh, faces, z, s.segments);
+// Segments by start edge (a list each, in segment order) and by end edge.
+void index_segments(Scratch& s) {
   const auto n = static_cast<std::int32_t>(s.segments.size());
   s.next_same_start.assign(static_cast<std::size_t>(n), -1);
   s.used.assign(static_cast<std::size_t>(n), 0);
@@ -158,84 +155,104 @@ Slice slice_one(const Mesh& mesh, std::span<const std::int32_t> faces, double z,
     head = i;
     s.ends.slot(seg.end_edge, inserted) = i;
   }
+}
 
+// Loops (closed, with their shell) and open chains of one slice, as they are traced.
+struct Chains {
   std::vector<Loop> loops;
   std::vector<int> loop_shell;
-  auto trace = [&](std::int32_t first) {
-    const Segment& head = s.segments[static_cast<std::size_t>(first)];
-    const std::int32_t shell = mesh.shell_id[static_cast<std::size_t>(head.face)];
-    Loop loop;
-    std::int32_t cur = first;
-    bool closed = false;
-    for (;;) {
-      s.used[static_cast<std::size_t>(cur)] = 1;
-      const Segment& seg = s.segments[static_cast<std::size_t>(cur)];
-      loop.points.push_back(seg.start);
-      loop.facets.push_back(seg.face);
-      if (seg.end_edge == head.start_edge) {  // back where we started
-        closed = true;
-        break;
-      }
-      const std::int32_t nxt = next_segment(mesh, s, seg.end_edge, shell);
-      if (nxt < 0) {  // the chain ends on a boundary edge of an open mesh
-        loop.points.push_back(edge_point(mesh, seg.end_edge, z));
-        break;
-      }
-      cur = nxt;
+};
+
+// The chain from segment `first`, within its shell: a loop when it comes back to its start, an
+// open chain (into slice.open_chains) when it ends on a boundary edge of an open mesh.
+void trace_chain(const Mesh& mesh, Scratch& s, std::int32_t first, double z, Chains& c, Slice& slice) {
+  const Segment& head = s.segments[static_cast<std::size_t>(first)];
+  const std::int32_t shell = mesh.shell_id[static_cast<std::size_t>(head.face)];
+  Loop loop;
+  std::int32_t cur = first;
+  bool closed = false;
+  for (;;) {
+    s.used[static_cast<std::size_t>(cur)] = 1;
+    const Segment& seg = s.segments[static_cast<std::size_t>(cur)];
+    loop.points.push_back(seg.start);
+    loop.facets.push_back(seg.face);
+    if (seg.end_edge == head.start_edge) {  // back where we started
+      closed = true;
+      break;
     }
-    if (closed) {
-      drop_zero_length(loop, true);
-      if (loop.points.size() >= 3) {
-        loops.push_back(std::move(loop));
-        loop_shell.push_back(shell);
-      }
-    } else {
-      OpenChain chain;
-      chain.points = std::move(loop.points);
-      chain.facets = std::move(loop.facets);
-      drop_zero_length(chain, false);
-      slice.open_chains.push_back(std::move(chain));
+    const std::int32_t nxt = next_segment(mesh, s, seg.end_edge, shell);
+    if (nxt < 0) {  // the chain ends on a boundary edge of an open mesh
+      loop.points.push_back(edge_point(mesh, seg.end_edge, z));
+      break;
     }
-  };
+    cur = nxt;
+  }
+  if (closed) {
+    drop_zero_length(loop, true);
+    if (loop.points.size() >= 3) {
+      c.loops.push_back(std::move(loop));
+      c.loop_shell.push_back(shell);
+    }
+    return;
+  }
+  OpenChain chain;
+  chain.points = std::move(loop.points);
+  chain.facets = std::move(loop.facets);
+  drop_zero_length(chain, false);
+  slice.open_chains.push_back(std::move(chain));
+}
+
+// Open chains closed across gaps no wider than the gap rule (each its own body), or said.
+void close_open_chains(const SliceParams& params, double z, Chains& c, Slice& slice) {
+  if (slice.open_chains.empty()) return;
+  if (params.gap_close_mm > 0.0) {
+    std::vector<OpenChain> pending = slice.open_chains;
+    for (Loop& loop : detail::close_gaps(pending, params.gap_close_mm, slice.warnings)) {
+      c.loops.push_back(std::move(loop));
+      c.loop_shell.push_back(-1 - static_cast<int>(c.loop_shell.size()));
+    }
+  } else {
+    slice.warnings.push_back(
+        fmt::format("z={:.4f} mm: {} open chain(s) left open (gap rule disabled)", z, slice.open_chains.size()));
+  }
+}
+
+// Loops of different shells that meet: their union. Where they only touch the union is the
+// loops themselves; report (and use) it only when it differs.
+void unite_shells(Chains& c, double z, Slice& slice) {
+  if (!detail::needs_union(c.loops, c.loop_shell)) return;
+  std::vector<Loop> merged = detail::union_of_loops(c.loops);
+  for (Loop& loop : merged) detail::compute_area(loop);
+  double before = 0.0, after = 0.0;
+  for (const Loop& l : c.loops) before += l.area_mm2;
+  for (const Loop& l : merged) after += l.area_mm2;
+  if (merged.size() != c.loops.size() || std::abs(after - before) > 1e-12 * std::max(1.0, std::abs(before))) {
+    detail::compute_nesting(merged);
+    c.loops = std::move(merged);
+    slice.warnings.push_back(fmt::format("z={:.4f} mm: overlapping shells, contours replaced by their union", z));
+  }
+}
+
+Slice slice_one(const Mesh& mesh, std::span<const std::int32_t> faces, double z,
+                const SliceParams& params, Scratch& s) {
+  Slice slice;
+  slice.z_mm = z;
+  collect_segments(mesh, faces, z, s.segments);
+  index_segments(s);
+  const auto n = static_cast<std::int32_t>(s.segments.size());
+  Chains c;
   // Open chains first, from segments nothing leads into, so each is traced from its true start.
   for (std::int32_t i = 0; i < n; ++i) {
     if (s.used[static_cast<std::size_t>(i)]) continue;
-    if (s.ends.find(s.segments[static_cast<std::size_t>(i)].start_edge) < 0) trace(i);
+    if (s.ends.find(s.segments[static_cast<std::size_t>(i)].start_edge) < 0) trace_chain(mesh, s, i, z, c, slice);
   }
   for (std::int32_t i = 0; i < n; ++i)
-    if (!s.used[static_cast<std::size_t>(i)]) trace(i);
-
-  if (!slice.open_chains.empty()) {
-    if (params.gap_close_mm > 0.0) {
-      std::vector<OpenChain> pending = slice.open_chains;
-      for (Loop& loop : detail::close_gaps(pending, params.gap_close_mm, slice.warnings)) {
-        loops.push_back(std::move(loop));
-        loop_shell.push_back(-1 - static_cast<int>(loop_shell.size()));  // each its own body
-      }
-    } else {
-      slice.warnings.push_back(fmt::format("z={:.4f} mm: {} open chain(s) left open (gap rule disabled)",
-                                           z, slice.open_chains.size()));
-    }
-  }
-
-  for (Loop& loop : loops) detail::compute_area(loop);
-  detail::compute_nesting(loops);
-  if (detail::needs_union(loops, loop_shell)) {
-    // Loops of different shells meet. Where they only touch the union is the loops themselves;
-    // report (and use) it only when it differs.
-    std::vector<Loop> merged = detail::union_of_loops(loops);
-    for (Loop& loop : merged) detail::compute_area(loop);
-    double before = 0.0, after = 0.0;
-    for (const Loop& l : loops) before += l.area_mm2;
-    for (const Loop& l : merged) after += l.area_mm2;
-    if (merged.size() != loops.size() || std::abs(after - before) > 1e-12 * std::max(1.0, std::abs(before))) {
-      detail::compute_nesting(merged);
-      loops = std::move(merged);
-      slice.warnings.push_back(
-          fmt::format("z={:.4f} mm: overlapping shells, contours replaced by their union", z));
-    }
-  }
-  slice.loops = std::move(loops);
+    if (!s.used[static_cast<std::size_t>(i)]) trace_chain(mesh, s, i, z, c, slice);
+  close_open_chains(params, z, c, slice);
+  for (Loop& loop : c.loops) detail::compute_area(loop);
+  detail::compute_nesting(c.loops);
+  unite_shells(c, z, slice);
+  slice.loops = std::move(c.loops);
   return slice;
 }
 
