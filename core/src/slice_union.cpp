@@ -120,10 +120,21 @@ bool needs_union(const std::vector<Loop>& loops, const std::vector<int>& loop_sh
   return meet;
 }
 
-std::vector<Loop> union_of_loops(const std::vector<Loop>& loops) {
-  // 1. Split points per (loop, vector): parameter along the vector and the shared point.
-  std::vector<std::vector<std::vector<std::pair<double, Eigen::Vector2d>>>> splits(loops.size());
-  std::set<std::pair<double, double>> junctions;  // every meeting point, split or not
+namespace {
+
+using Splits = std::vector<std::vector<std::vector<std::pair<double, Eigen::Vector2d>>>>;
+using Junctions = std::set<std::pair<double, double>>;
+
+struct Piece {
+  Eigen::Vector2d a, b;
+  std::int32_t facet;
+  std::size_t loop;
+};
+
+// Split points per (loop, vector): parameter along the vector and the shared point; and every
+// meeting point, split or not.
+void find_splits(const std::vector<Loop>& loops, Splits& splits, Junctions& junctions) {
+  splits.assign(loops.size(), {});
   for (std::size_t l = 0; l < loops.size(); ++l) splits[l].resize(loops[l].points.size());
   for_each_intersection(
       segments_of(loops), [](std::size_t, std::size_t) { return true; },
@@ -134,61 +145,67 @@ std::vector<Loop> union_of_loops(const std::vector<Loop>& loops) {
         if (h.t_o > 0 && h.t_o < 1) splits[o.loop][o.index].emplace_back(h.t_o, h.point);
         return true;
       });
+}
 
-  // 2. Pieces, grouped into runs between crossings; one winding evaluation per run.
-  struct Piece {
-    Eigen::Vector2d a, b;
-    std::int32_t facet;
-    std::size_t loop;
-  };
+// Loop l cut at its split points into pieces.
+std::vector<Piece> pieces_of(const Loop& loop, std::size_t l, std::vector<std::vector<std::pair<double, Eigen::Vector2d>>>& sp_of) {
+  std::vector<Piece> pieces;
+  const std::size_t n = loop.points.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    auto& sp = sp_of[i];
+    std::sort(sp.begin(), sp.end(), [](const auto& p, const auto& q) { return p.first < q.first; });
+    Eigen::Vector2d from = loop.points[i];
+    for (const auto& [t, p] : sp) {
+      if (p == from) continue;
+      pieces.push_back({from, p, loop.facets[i], l});
+      from = p;
+    }
+    if (from != loop.points[(i + 1) % n]) pieces.push_back({from, loop.points[(i + 1) % n], loop.facets[i], l});
+  }
+  return pieces;
+}
+
+// Whether a run of pieces [b, e) is on the union's boundary: just right of its longest piece
+// (the least likely to touch another loop; its outside) the total winding is 0. Off the piece
+// itself, so a coincident wall of another body is on a definite side.
+bool run_on_boundary(const std::vector<Piece>& pieces, std::size_t b, std::size_t e, const std::vector<Loop>& loops) {
+  std::size_t probe = b;
+  for (std::size_t k = b; k < e; ++k)
+    if ((pieces[k].b - pieces[k].a).squaredNorm() > (pieces[probe].b - pieces[probe].a).squaredNorm()) probe = k;
+  const Eigen::Vector2d d = pieces[probe].b - pieces[probe].a;
+  const Eigen::Vector2d mid = 0.5 * (pieces[probe].a + pieces[probe].b);
+  const double step = std::max(1e-9 * d.norm(), 1e-12 * (1.0 + mid.cwiseAbs().maxCoeff()));  // well above an ulp
+  const Eigen::Vector2d right = mid + step * Eigen::Vector2d(d.y(), -d.x()).normalized();
+  int w = 0;
+  for (const Loop& o : loops) w += winding_number(o, right);
+  return w == 0;
+}
+
+// The pieces on the union's boundary: runs between meeting points, one winding evaluation per
+// run. Coincident walls facing the same way (two bodies flush on one side) survive twice: one kept.
+std::vector<Piece> boundary_pieces(const std::vector<Loop>& loops, Splits& splits, const Junctions& junctions) {
   std::vector<Piece> kept;
   for (std::size_t l = 0; l < loops.size(); ++l) {
-    const Loop& loop = loops[l];
-    std::vector<Piece> pieces;
-    std::vector<std::size_t> run_start{0};  // a run is a stretch between meeting points
-    const std::size_t n = loop.points.size();
-    for (std::size_t i = 0; i < n; ++i) {
-      auto& sp = splits[l][i];
-      std::sort(sp.begin(), sp.end(), [](const auto& p, const auto& q) { return p.first < q.first; });
-      Eigen::Vector2d from = loop.points[i];
-      for (const auto& [t, p] : sp) {
-        if (p == from) continue;
-        pieces.push_back({from, p, loop.facets[i], l});
-        from = p;
-      }
-      if (from != loop.points[(i + 1) % n]) pieces.push_back({from, loop.points[(i + 1) % n], loop.facets[i], l});
-    }
+    const std::vector<Piece> pieces = pieces_of(loops[l], l, splits[l]);
+    std::vector<std::size_t> run_start{0};
     for (std::size_t k = 1; k < pieces.size(); ++k)
       if (junctions.count({pieces[k].a.x(), pieces[k].a.y()})) run_start.push_back(k);
     run_start.push_back(pieces.size());
     for (std::size_t r = 0; r + 1 < run_start.size(); ++r) {
       if (run_start[r] == run_start[r + 1]) continue;
-      // The longest piece of the run is the least likely to touch another loop.
-      std::size_t probe = run_start[r];
-      for (std::size_t k = run_start[r]; k < run_start[r + 1]; ++k)
-        if ((pieces[k].b - pieces[k].a).squaredNorm() > (pieces[probe].b - pieces[probe].a).squaredNorm()) probe = k;
-      // Just right of the piece (its outside): the union's boundary has total winding 0 there.
-      // Off the piece itself, so a coincident wall of another body is on a definite side.
-      const Eigen::Vector2d d = pieces[probe].b - pieces[probe].a;
-      const Eigen::Vector2d mid = 0.5 * (pieces[probe].a + pieces[probe].b);
-      const double step = std::max(1e-9 * d.norm(), 1e-12 * (1.0 + mid.cwiseAbs().maxCoeff()));  // well above an ulp
-      const Eigen::Vector2d right = mid + step * Eigen::Vector2d(d.y(), -d.x()).normalized();
-      int w = 0;
-      for (std::size_t o = 0; o < loops.size(); ++o) w += winding_number(loops[o], right);
-      if (w == 0)
+      if (run_on_boundary(pieces, run_start[r], run_start[r + 1], loops))
         for (std::size_t k = run_start[r]; k < run_start[r + 1]; ++k) kept.push_back(pieces[k]);
     }
   }
-  // Coincident walls facing the same way (two bodies flush on one side) survive twice: keep one.
-  {
-    std::set<std::array<double, 4>> seen;
-    std::vector<Piece> unique;
-    for (const Piece& p : kept)
-      if (seen.insert({p.a.x(), p.a.y(), p.b.x(), p.b.y()}).second) unique.push_back(p);
-    kept = std::move(unique);
-  }
+  std::set<std::array<double, 4>> seen;
+  std::vector<Piece> unique;
+  for (const Piece& p : kept)
+    if (seen.insert({p.a.x(), p.a.y(), p.b.x(), p.b.y()}).second) unique.push_back(p);
+  return unique;
+}
 
-  // 3. Chain the kept pieces by exact end-point equality.
+// The kept pieces chained by exact end-point equality into closed loops.
+std::vector<Loop> chain_pieces(const std::vector<Piece>& kept) {
   auto key = [](const Eigen::Vector2d& p) { return std::pair<double, double>(p.x(), p.y()); };
   std::multimap<std::pair<double, double>, std::size_t> by_start;
   for (std::size_t i = 0; i < kept.size(); ++i) by_start.emplace(key(kept[i].a), i);
@@ -218,6 +235,15 @@ std::vector<Loop> union_of_loops(const std::vector<Loop>& loops) {
     if (closed && loop.points.size() >= 3) out.push_back(std::move(loop));
   }
   return out;
+}
+
+}  // namespace
+
+std::vector<Loop> union_of_loops(const std::vector<Loop>& loops) {
+  Splits splits;
+  Junctions junctions;
+  find_splits(loops, splits, junctions);
+  return chain_pieces(boundary_pieces(loops, splits, junctions));
 }
 
 }  // namespace lamina::detail
