@@ -90,6 +90,9 @@ struct AxisWords {
 // The program as written so far and the controller's modal state it leaves: only words that
 // change are written.
 struct ProgramWriter {
+  ProgramWriter(const SheetToolpath& t, const HeadKinematics& h, const PostParams& p, const std::vector<AxisPose>& ps)
+      : toolpath(t), head(h), params(p), poses(ps) {}
+
   const SheetToolpath& toolpath;
   const HeadKinematics& head;
   const PostParams& params;

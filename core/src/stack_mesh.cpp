@@ -102,6 +102,8 @@ struct TangleFinder {
     std::uint32_t ring, index;
     Eigen::Vector2d a, b;
   };
+  TangleFinder(const Rings& r, const Rings& b, Marks& m) : rings(r), base(b), marks(m) {}
+
   const Rings& rings;
   const Rings& base;
   Marks& marks;

@@ -22,7 +22,7 @@ struct SimCutOptions {
   std::vector<std::string> program = contour_program(3, 150);
   double baud = 115200;  // the simulator's line and the host's pacing alike
   // The link to the simulator's PTY at `path` (default: grbl_pty_link at `baud`).
-  std::function<std::unique_ptr<Streamer>(const std::string& path)> make_link;
+  std::function<std::unique_ptr<Streamer>(const std::string& path)> make_link = {};
 };
 
 struct SimCut {

@@ -116,8 +116,9 @@ TEST(LayeringVertical, BondGapShiftsEveryLayer) {
   double sheets = 0;
   for (std::size_t i = 0; i < r->layers.size(); ++i) {
     sheets += r->layers[i].thickness_mm;
-    if (i > 0)
+    if (i > 0) {
       EXPECT_NEAR(r->layers[i].z_bottom_mm, r->layers[i - 1].z_top_mm() + 0.2, 1e-12) << "layer " << i;
+    }
   }
   const double bonds = 0.2 * static_cast<double>(r->layers.size() - 1);
   EXPECT_NEAR(r->stack_height_mm, sheets + bonds, 1e-12);

@@ -43,7 +43,7 @@ struct CutJobSettings {
   double jet_restart_s = 1.0;
   // Where the program's contours are, as the post made it (the plan's report); none: read from
   // its (CONTOUR n …) markers (a program from elsewhere, `lamina stream`).
-  std::optional<ProgramMap> program_map;
+  std::optional<ProgramMap> program_map = std::nullopt;
 };
 
 enum class CutState { ready, preparing, cutting, stopping, stopped, completed, failed };
