@@ -162,6 +162,70 @@ GrblStatus apply_m(int code, Block& b, Seen& seen, const ParseParams& params) {
   return GrblStatus::ok;
 }
 
+// A value word other than G and M (each letter once a block); axis words set `any_axis`.
+GrblStatus apply_word(char letter, double value, Block& b, Seen& seen, bool& any_axis, const ParseParams& params) {
+  if (seen.letters.find(letter) != std::string::npos) return GrblStatus::word_repeated;
+  seen.letters.push_back(letter);
+  switch (letter) {
+    case 'N':
+      if (value < 0 || value > kMaxLineNumber || !is_integer(value)) return GrblStatus::invalid_line_number;
+      b.line_number = static_cast<std::int64_t>(std::llround(value));
+      break;
+    case 'F':
+      if (value < 0) return GrblStatus::negative_value;
+      b.feed_word = value;
+      break;
+    case 'P':
+      if (value < 0) return GrblStatus::negative_value;
+      b.dwell_s = value * params.dwell_p_unit_s;
+      break;
+    case 'I': b.i_mm = value; break;
+    case 'J': b.j_mm = value; break;
+    case 'K': b.k_mm = value; break;
+    case 'R': b.r_mm = value; break;
+    case 'T': case 'S': break;  // accepted, no meaning on a waterjet
+    case 'B': case 'D': case 'E': case 'H': case 'L': case 'Q': case 'U': case 'V': case 'W':
+      b.unused_word = true;
+      break;
+    case 'O':
+      if (!is_integer(value) || value < 0) return GrblStatus::command_value_not_integer;
+      break;
+    default:
+      b.axis_words[static_cast<std::size_t>(axis_index(letter))] = value;
+      any_axis = true;
+  }
+  return GrblStatus::ok;
+}
+
+// The words of a stripped, non-empty line, one after the other.
+GrblStatus parse_words(const std::string& text, Block& b, Seen& seen, bool& any_axis, const ParseParams& params) {
+  for (std::size_t i = 0; i < text.size();) {
+    const char raw = text[i];
+    if (!is_ascii_letter(raw)) return GrblStatus::expected_command_letter;
+    const char letter = upper(raw);
+    std::size_t j = i + 1;
+    while (j < text.size() && is_number_char(text[j])) ++j;
+    const std::string_view number(text.data() + i + 1, j - i - 1);
+    i = j;
+    // Unknown letters are refused before their number is looked at: the letter is the problem.
+    static constexpr std::string_view kKnown = "GMNFPXYZACIJKRTSBDEHLQUVW";
+    const bool program_number = letter == 'O' && params.accept_program_number;
+    if (kKnown.find(letter) == std::string_view::npos && !program_number) return GrblStatus::unsupported_command;
+    double value = 0;
+    if (!parse_number(number, value)) return GrblStatus::bad_number_format;
+    GrblStatus s = GrblStatus::ok;
+    if (letter == 'G' || letter == 'M') {
+      if (!is_integer(value)) return GrblStatus::command_value_not_integer;
+      const int code = static_cast<int>(std::lround(value));
+      s = letter == 'G' ? apply_g(code, b, seen) : apply_m(code, b, seen, params);
+    } else {
+      s = apply_word(letter, value, b, seen, any_axis, params);
+    }
+    if (s != GrblStatus::ok) return s;
+  }
+  return GrblStatus::ok;
+}
+
 }  // namespace
 
 ParseResult parse_block(std::string_view line, const ParseParams& params) {
@@ -172,7 +236,6 @@ ParseResult parse_block(std::string_view line, const ParseParams& params) {
     return r;
   };
   if (line.size() > params.max_line_chars) return fail(GrblStatus::overflow);
-
   std::string text;
   if (!strip(line, text)) return fail(GrblStatus::expected_command_letter);
   if (text == "%") {
@@ -183,68 +246,10 @@ ParseResult parse_block(std::string_view line, const ParseParams& params) {
     r.block.comment_only = true;
     return r;
   }
-
   Block& b = r.block;
   Seen seen;
   bool any_axis = false;
-  std::size_t i = 0;
-  while (i < text.size()) {
-    const char raw = text[i];
-    if (!is_ascii_letter(raw)) return fail(GrblStatus::expected_command_letter);
-    const char letter = upper(raw);
-    std::size_t j = i + 1;
-    while (j < text.size() && is_number_char(text[j])) ++j;
-    const std::string_view number(text.data() + i + 1, j - i - 1);
-    i = j;
-
-    // Unknown letters are refused before their number is looked at: the letter is the problem.
-    static constexpr std::string_view kKnown = "GMNFPXYZACIJKRTSBDEHLQUVW";
-    const bool program_number = letter == 'O' && params.accept_program_number;
-    if (kKnown.find(letter) == std::string_view::npos && !program_number)
-      return fail(GrblStatus::unsupported_command);
-    double value = 0;
-    if (!parse_number(number, value)) return fail(GrblStatus::bad_number_format);
-
-    if (letter == 'G' || letter == 'M') {
-      if (!is_integer(value)) return fail(GrblStatus::command_value_not_integer);
-      const int code = static_cast<int>(std::lround(value));
-      const GrblStatus s = letter == 'G' ? apply_g(code, b, seen) : apply_m(code, b, seen, params);
-      if (s != GrblStatus::ok) return fail(s);
-      continue;
-    }
-    if (seen.letters.find(letter) != std::string::npos) return fail(GrblStatus::word_repeated);
-    seen.letters.push_back(letter);
-    switch (letter) {
-      case 'N':
-        if (value < 0 || value > kMaxLineNumber || !is_integer(value))
-          return fail(GrblStatus::invalid_line_number);
-        b.line_number = static_cast<std::int64_t>(std::llround(value));
-        break;
-      case 'F':
-        if (value < 0) return fail(GrblStatus::negative_value);
-        b.feed_word = value;
-        break;
-      case 'P':
-        if (value < 0) return fail(GrblStatus::negative_value);
-        b.dwell_s = value * params.dwell_p_unit_s;
-        break;
-      case 'I': b.i_mm = value; break;
-      case 'J': b.j_mm = value; break;
-      case 'K': b.k_mm = value; break;
-      case 'R': b.r_mm = value; break;
-      case 'T': case 'S': break;  // accepted, no meaning on a waterjet
-      case 'B': case 'D': case 'E': case 'H': case 'L': case 'Q': case 'U': case 'V': case 'W':
-        b.unused_word = true;
-        break;
-      case 'O':
-        if (!is_integer(value) || value < 0) return fail(GrblStatus::command_value_not_integer);
-        break;
-      default:
-        b.axis_words[static_cast<std::size_t>(axis_index(letter))] = value;
-        any_axis = true;
-    }
-  }
-
+  if (const GrblStatus s = parse_words(text, b, seen, any_axis, params); s != GrblStatus::ok) return fail(s);
   // grblHAL: G28 sets the axis command itself, a motion command beside it is a conflict.
   if (b.go_home && seen.motion_group) return fail(GrblStatus::axis_command_conflict);
   if (b.motion == MotionMode::dwell) {

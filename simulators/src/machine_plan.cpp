@@ -111,10 +111,8 @@ void plan_go_home(bool any_axis, const std::array<std::optional<double>, kAxisCo
   p.target = home;
 }
 
-}  // namespace
-
-GrblStatus plan_block(const Block& block, ModalState& modal, const AxisValues& from,
-                      const MachineConfig& config, PlannedBlock& out) {
+// The modal state after the block's mode words (units, distance, feed mode, feed, motion).
+ModalState next_modal(const ModalState& modal, const Block& block) {
   ModalState m = modal;
   if (block.set_inches) m.inches = *block.set_inches;
   if (block.set_relative) m.relative = *block.set_relative;
@@ -127,7 +125,47 @@ GrblStatus plan_block(const Block& block, ModalState& modal, const AxisValues& f
   if (block.motion == MotionMode::rapid || block.motion == MotionMode::linear ||
       block.motion == MotionMode::arc_cw || block.motion == MotionMode::arc_ccw)
     m.motion = block.motion;
+  return m;
+}
 
+// The move's duration and path length (rapids at the axes' rates, feeds at F or inverse time).
+GrblStatus time_move(const Block& block, const ModalState& m, const AxisValues& from, bool arc,
+                     const MachineConfig& config, PlannedBlock& p) {
+  switch (p.kind) {
+    case MotionMode::none: break;
+    case MotionMode::dwell: p.duration_s = *block.dwell_s; break;
+    case MotionMode::rapid:
+      if (p.via) {
+        p.duration_s = rapid_time_s(from, *p.via, config) + rapid_time_s(*p.via, p.target, config);
+        p.path_length = path_measure(from, *p.via) + path_measure(*p.via, p.target);
+      } else {
+        p.duration_s = rapid_time_s(from, p.target, config);
+        p.path_length = path_measure(from, p.target);
+      }
+      break;
+    case MotionMode::linear: case MotionMode::arc_cw: case MotionMode::arc_ccw: {
+      if (!arc) p.path_length = path_measure(from, p.target);
+      if (m.inverse_time) {
+        if (!block.feed_word || *block.feed_word <= 0) return GrblStatus::undefined_feed_rate;
+        p.duration_s = 60.0 / *block.feed_word;
+      } else {
+        if (!m.feed_mm_per_min || *m.feed_mm_per_min <= 0) return GrblStatus::undefined_feed_rate;
+        const double feed = std::min(*m.feed_mm_per_min, config.max_feed_mm_per_min);
+        p.duration_s = p.path_length / feed * 60.0;
+      }
+      p.duration_s = std::max(p.duration_s, rapid_time_s(from, p.target, config));
+      break;
+    }
+  }
+  return GrblStatus::ok;
+}
+
+}  // namespace
+
+GrblStatus plan_block(const Block& block, ModalState& modal, const AxisValues& from,
+                      const MachineConfig& config, PlannedBlock& out) {
+  const ModalState m = next_modal(modal, block);
+  const double unit = m.inches ? kMmPerInch : 1.0;
   PlannedBlock p;
   p.jet_on = block.jet_on;
   p.spindle = block.spindle;
@@ -163,33 +201,7 @@ GrblStatus plan_block(const Block& block, ModalState& modal, const AxisValues& f
       arc = false;
     }
   }
-
-  switch (p.kind) {
-    case MotionMode::none: break;
-    case MotionMode::dwell: p.duration_s = *block.dwell_s; break;
-    case MotionMode::rapid:
-      if (p.via) {
-        p.duration_s = rapid_time_s(from, *p.via, config) + rapid_time_s(*p.via, p.target, config);
-        p.path_length = path_measure(from, *p.via) + path_measure(*p.via, p.target);
-      } else {
-        p.duration_s = rapid_time_s(from, p.target, config);
-        p.path_length = path_measure(from, p.target);
-      }
-      break;
-    case MotionMode::linear: case MotionMode::arc_cw: case MotionMode::arc_ccw: {
-      if (!arc) p.path_length = path_measure(from, p.target);
-      if (m.inverse_time) {
-        if (!block.feed_word || *block.feed_word <= 0) return GrblStatus::undefined_feed_rate;
-        p.duration_s = 60.0 / *block.feed_word;
-      } else {
-        if (!m.feed_mm_per_min || *m.feed_mm_per_min <= 0) return GrblStatus::undefined_feed_rate;
-        const double feed = std::min(*m.feed_mm_per_min, config.max_feed_mm_per_min);
-        p.duration_s = p.path_length / feed * 60.0;
-      }
-      p.duration_s = std::max(p.duration_s, rapid_time_s(from, p.target, config));
-      break;
-    }
-  }
+  if (const GrblStatus s = time_move(block, m, from, arc, config, p); s != GrblStatus::ok) return s;
   if (p.path_length > 0 && p.duration_s > 0) p.feed_mm_per_min = p.path_length / p.duration_s * 60.0;
   if (p.kind != MotionMode::dwell && p.duration_s <= 0) p.path_length = 0;
   // grblHAL's last check: a value word nothing used (B on this XYZAC machine, …).
