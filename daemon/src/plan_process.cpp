@@ -118,6 +118,20 @@ pid_t spawn_limited(std::vector<char*>& argv, int log_fd, int progress_fd, const
   return pid;
 }
 
+// The planner's report.json, read with the planner's own schema (lamina/core/plan_report.hpp):
+// a planner of another version, or a bug on one side, fails the job with the key that differs —
+// never a sheet 0.
+std::expected<PlanReport, PlanProcessError> read_report(const std::filesystem::path& out_dir) {
+  std::ifstream in(out_dir / "report.json", std::ios::binary);
+  if (!in) return std::unexpected(PlanProcessError{false, "the planner wrote no report.json"});
+  const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  auto report = parse_plan_report(text);
+  if (!report)
+    return std::unexpected(PlanProcessError{false, fmt::format("the planner's report does not match this laminad: {}",
+                                                               report.error().message)});
+  return std::move(*report);
+}
+
 }  // namespace
 
 std::expected<PlanReport, PlanProcessError> run_plan_process(const PlanProcessRequest& r,
@@ -191,16 +205,7 @@ std::expected<PlanReport, PlanProcessError> run_plan_process(const PlanProcessRe
   if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
     return std::unexpected(PlanProcessError{false, fmt::format("planning failed: {}", tail_of_log(log))});
 
-  std::ifstream in(r.out_dir / "report.json", std::ios::binary);
-  if (!in) return std::unexpected(PlanProcessError{false, "the planner wrote no report.json"});
-  const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-  // Read with the planner's own schema (lamina/core/plan_report.hpp): a planner of another
-  // version, or a bug on one side, fails the job with the key that differs — never a sheet 0.
-  auto report = parse_plan_report(text);
-  if (!report)
-    return std::unexpected(PlanProcessError{false, fmt::format("the planner's report does not match this laminad: {}",
-                                                               report.error().message)});
-  return std::move(*report);
+  return read_report(r.out_dir);
 }
 
 }  // namespace lamina::daemon

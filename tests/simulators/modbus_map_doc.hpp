@@ -101,4 +101,17 @@ inline DocTables parse_doc(const std::string& text) {
   return tables;
 }
 
+// Every `inline constexpr … kName =` of the header at `path` is in `constants`, and no other:
+// a constant added to a side's map without being checked against the document fails.
+inline void expect_header_constants_known(const std::string& path, const std::vector<Constant>& constants) {
+  const std::string header = read_text(path);
+  ASSERT_FALSE(header.empty()) << "cannot read " << path;
+  const std::regex declaration(R"(inline\s+constexpr\s+[\w:]+\s+(k\w+)\s*=)");
+  std::set<std::string> in_header, in_test;
+  for (auto it = std::sregex_iterator(header.begin(), header.end(), declaration); it != std::sregex_iterator(); ++it)
+    in_header.insert((*it)[1]);
+  for (const Constant& c : constants) in_test.insert(c.name);
+  EXPECT_EQ(in_header, in_test) << "a constant of " << path << " is not checked against docs/modbus-map.md";
+}
+
 }  // namespace lamina::modbus_doc
