@@ -6,7 +6,7 @@
 //   build/bench/bench_readers --benchmark_filter=Obj
 #include "io_test_util.hpp"
 #include "lamina/core/mesh_io.hpp"
-#include "polygon_triangulation.hpp"  // core/src: the private header of the core being measured
+#include "geometry/polygon_triangulation.hpp"  // core/src: the private header of the core being measured
 
 #include <benchmark/benchmark.h>
 #include <fmt/format.h>

@@ -1,6 +1,6 @@
 // libFuzzer target: the ASCII STL parser itself (parse_stl would take most mutations for binary).
 #include "fuzz_check.hpp"
-#include "stl_detail.hpp"
+#include "io/stl_detail.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string_view text(reinterpret_cast<const char*>(data), size);

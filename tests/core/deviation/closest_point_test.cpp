@@ -1,7 +1,7 @@
 // Point-to-triangle distance and the triangle tree behind max_mm: against dense sampling of the
 // triangles (every Voronoi region of a triangle, degenerate triangles), and the tree against a
 // brute-force scan, including its early stop.
-#include "../../../core/src/closest_point.hpp"
+#include "deviation/closest_point.hpp"
 
 #include <gtest/gtest.h>
 

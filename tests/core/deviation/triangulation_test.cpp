@@ -1,7 +1,7 @@
 // Polygon-with-holes triangulation (ear clipping with hole bridges): every vertex used, n + 2h − 2
 // triangles, the area of the polygon, and a closed edge structure (every boundary edge once,
 // every inner edge twice in opposite directions), on hand-made and seeded random polygons.
-#include "../../../core/src/polygon_triangulation.hpp"
+#include "geometry/polygon_triangulation.hpp"
 
 #include <gtest/gtest.h>
 

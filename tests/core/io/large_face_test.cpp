@@ -1,7 +1,7 @@
 // OBJ faces with many corners (issue 16, item 12): a 100,000-corner face took 60 s of ear clipping,
 // every ear tested against every corner. Large faces now go through the indexed clipper: the
 // work is counted (ear tests and the corners looked at), not timed, and must stay about linear.
-#include "../../../core/src/ear_clipping.hpp"
+#include "geometry/ear_clipping.hpp"
 #include "io_test_util.hpp"
 #include "lamina/core/mesh_io.hpp"
 #include "lamina/core/polygon.hpp"

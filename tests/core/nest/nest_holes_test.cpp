@@ -4,8 +4,8 @@
 #include "nest_checks.hpp"
 
 // Private headers of lamina_core: the hole filler and its polygon algebra alone.
-#include "../../../core/src/nest_fit.hpp"
-#include "../../../core/src/nest_internal.hpp"
+#include "cam/nest_fit.hpp"
+#include "cam/nest_internal.hpp"
 
 #include <gtest/gtest-spi.h>
 #include <gtest/gtest.h>

@@ -3,7 +3,7 @@
 #include "nest_checks.hpp"
 
 // Private header of lamina_core: the packing step alone, with libnest2d's own placed shapes.
-#include "../../../core/src/nest_internal.hpp"
+#include "cam/nest_internal.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,0 +1,586 @@
+// The bevel plan (paper 3-4, 3-5): per layer, the outline every sub-slice fits in (the vertical
+// "outside" edge), stations along it, each station's profile read on every sub-slice along its
+// normal, the cut lines fitted to that profile, and passes assembled from the lines.
+#include "lamina/core/bevel.hpp"
+
+#include "bevel/bevel_distance.hpp"
+#include "bevel/bevel_gouge.hpp"
+#include "geometry/clipper_bridge.hpp"
+#include "lamina/core/section_lines.hpp"
+#include "lamina/core/slice.hpp"
+
+#include <Eigen/Geometry>
+#include <fmt/format.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <optional>
+
+namespace lamina {
+
+std::vector<double> sub_slice_heights(double z_bottom_mm, double thickness_mm, double sub_slice_mm) {
+  std::vector<double> zs;
+  if (!(thickness_mm > 0.0) || !(sub_slice_mm > 0.0)) return zs;
+  const double nudge = std::min(1e-3, 0.01 * thickness_mm);
+  const int intervals = std::max(1, static_cast<int>(std::ceil(thickness_mm / sub_slice_mm - 1e-9)));
+  zs.reserve(static_cast<std::size_t>(intervals) + 1);
+  for (int i = 0; i <= intervals; ++i) {
+    double z = z_bottom_mm + thickness_mm * i / intervals;
+    if (i == 0) z += nudge;
+    if (i == intervals) z -= nudge;
+    zs.push_back(z);
+  }
+  return zs;
+}
+
+namespace {
+
+struct OutlineRing {
+  Polygon2 points;
+  bool is_hole = false;
+  int parent = -1;
+};
+
+// Material that lies between two sub-slices and outside both: a bore's underside, the top of a
+// dome, a step — where the surface turns (nearly) horizontal between two thin slices. Such a
+// facet's part inside the layer is projected onto the layer's outline; facets whose clipped
+// corners all sit inside a neighbouring sub-slice add nothing and are skipped (the common case
+// on smooth surfaces, and what keeps this cheap).
+ClipperLib::Paths facet_shadows(const Mesh& mesh, const std::vector<double>& zs, const std::vector<SectionLines>& sections) {
+  ClipperLib::Paths shadows;
+  // Between the outer sub-slices, which are read just inside the faces: a flat face of the
+  // model lying on a layer face belongs to the neighbouring layer.
+  const double zb = zs.front(), zt = zs.back();
+  std::vector<Eigen::Vector3d> poly, next;
+  auto inside_neighbour = [&](const Eigen::Vector3d& v) {
+    const auto it = std::upper_bound(zs.begin(), zs.end(), v.z());
+    const std::size_t hi = std::min<std::size_t>(static_cast<std::size_t>(it - zs.begin()), zs.size() - 1);
+    const std::size_t lo = hi > 0 ? hi - 1 : 0;
+    const Eigen::Vector2d p = v.head<2>();
+    return sections[lo].contains(p) || sections[hi].contains(p);
+  };
+  for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
+    if (std::abs(mesh.normals[f].z()) < 0.02) continue;  // a wall: its shadow is a line
+    const auto& tri = mesh.faces[f];
+    const Eigen::Vector3d& a = mesh.vertices[static_cast<std::size_t>(tri[0])];
+    const Eigen::Vector3d& b = mesh.vertices[static_cast<std::size_t>(tri[1])];
+    const Eigen::Vector3d& c = mesh.vertices[static_cast<std::size_t>(tri[2])];
+    const double lo = std::min({a.z(), b.z(), c.z()}), hi = std::max({a.z(), b.z(), c.z()});
+    if (hi < zb || lo > zt) continue;
+    // Clip to zb ≤ z ≤ zt (Sutherland–Hodgman on the two planes).
+    poly.assign({a, b, c});
+    for (int side = 0; side < 2 && !poly.empty(); ++side) {
+      next.clear();
+      auto keep = [&](const Eigen::Vector3d& v) { return side == 0 ? v.z() >= zb : v.z() <= zt; };
+      const double plane = side == 0 ? zb : zt;
+      for (std::size_t i = 0; i < poly.size(); ++i) {
+        const Eigen::Vector3d& p = poly[i];
+        const Eigen::Vector3d& q = poly[(i + 1) % poly.size()];
+        if (keep(p)) next.push_back(p);
+        if (keep(p) != keep(q)) next.push_back(p + (q - p) * ((plane - p.z()) / (q.z() - p.z())));
+      }
+      poly.swap(next);
+    }
+    if (poly.size() < 3) continue;
+    // Corners, edge midpoints and the centre: a facet bridging a hole of its neighbours (a
+    // tunnel's roof) has its corners inside but not its middle.
+    bool all_inside = true;
+    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+    for (std::size_t i = 0; i < poly.size() && all_inside; ++i) {
+      centre += poly[i];
+      all_inside = inside_neighbour(poly[i]) && inside_neighbour(0.5 * (poly[i] + poly[(i + 1) % poly.size()]));
+    }
+    all_inside = all_inside && inside_neighbour(centre / static_cast<double>(poly.size()));
+    if (all_inside) continue;
+    Polygon2 ring;
+    for (const auto& v : poly) ring.emplace_back(v.x(), v.y());
+    if (signed_area_mm2(ring) < 0) std::reverse(ring.begin(), ring.end());
+    shadows.push_back(detail::to_clipper(ring));
+  }
+  return shadows;
+}
+
+// The facets inside a layer, bucketed by their footprint, so that a station can read the exact
+// trace of the surface in its profile plane (every facet the plane cuts), not only the points
+// on the sub-slices.
+class SlabFacets {
+ public:
+  SlabFacets(const Mesh& mesh, double zb, double zt, double cell_mm) : mesh_(mesh), zb_(zb), zt_(zt) {
+    Eigen::Vector2d lo(std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()), hi = -lo;
+    for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
+      const auto [a, b, c] = corners(f);
+      const double zl = std::min({a.z(), b.z(), c.z()}), zh = std::max({a.z(), b.z(), c.z()});
+      if (zh < zb || zl > zt) continue;
+      facets_.push_back(static_cast<std::uint32_t>(f));
+      lo = lo.cwiseMin(a.head<2>()).cwiseMin(b.head<2>()).cwiseMin(c.head<2>());
+      hi = hi.cwiseMax(a.head<2>()).cwiseMax(b.head<2>()).cwiseMax(c.head<2>());
+    }
+    if (facets_.empty()) return;
+    origin_ = lo;
+    const Eigen::Vector2d size = (hi - lo).cwiseMax(1e-9);
+    cell_ = std::max({cell_mm, std::sqrt(size.x() * size.y() / static_cast<double>(facets_.size())), std::max(size.x(), size.y()) / 2048.0});
+    nx_ = std::max(1, static_cast<int>(std::ceil(size.x() / cell_)));
+    ny_ = std::max(1, static_cast<int>(std::ceil(size.y() / cell_)));
+    begin_.assign(static_cast<std::size_t>(nx_) * ny_ + 1, 0);
+    auto each_cell = [&](std::uint32_t f, auto&& fn) {
+      const auto [a, b, c] = corners(f);
+      const Eigen::Vector2d l = (a.head<2>().cwiseMin(b.head<2>()).cwiseMin(c.head<2>()) - origin_) / cell_;
+      const Eigen::Vector2d h = (a.head<2>().cwiseMax(b.head<2>()).cwiseMax(c.head<2>()) - origin_) / cell_;
+      for (int y = clampi(l.y(), ny_); y <= clampi(h.y(), ny_); ++y)
+        for (int x = clampi(l.x(), nx_); x <= clampi(h.x(), nx_); ++x) fn(static_cast<std::size_t>(y) * nx_ + x);
+    };
+    for (std::uint32_t f : facets_) each_cell(f, [&](std::size_t c) { ++begin_[c + 1]; });
+    for (std::size_t c = 0; c + 1 < begin_.size(); ++c) begin_[c + 1] += begin_[c];
+    items_.resize(begin_.back());
+    std::vector<std::uint32_t> fill(begin_.begin(), begin_.end() - 1);
+    for (std::uint32_t i = 0; i < facets_.size(); ++i) each_cell(facets_[i], [&](std::size_t c) { items_[fill[c]++] = i; });
+    stamp_.assign(facets_.size(), 0u);
+  }
+
+  // Points of the surface's trace in the vertical plane through `base` along `n`, for u in
+  // [u_min, u_max] and z in the layer: the ends of every facet's cut by the plane, clipped.
+  void trace(const Eigen::Vector2d& base, const Eigen::Vector2d& n, double u_min, double u_max,
+             std::vector<ProfileBound>& out, std::vector<std::uint32_t>& seen) const {
+    out.clear();
+    seen.clear();
+    if (facets_.empty()) return;
+    const Eigen::Vector2d t(-n.y(), n.x());
+    const double len = u_max - u_min;
+    const int steps = std::max(1, static_cast<int>(std::ceil(len / (0.5 * cell_))));
+    // The cells the line passes (and their neighbours: it may cut a corner between two
+    // samples), each once; then their facets, each once (stamped).
+    cells_.clear();
+    for (int k = 0; k <= steps; ++k) {
+      const Eigen::Vector2d p = (base + (u_min + len * k / steps) * n - origin_) / cell_;
+      const int cx = static_cast<int>(std::floor(p.x())), cy = static_cast<int>(std::floor(p.y()));
+      for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
+          const int x = cx + dx, y = cy + dy;
+          if (x < 0 || y < 0 || x >= nx_ || y >= ny_) continue;
+          cells_.push_back(static_cast<std::uint32_t>(y * nx_ + x));
+        }
+      }
+    }
+    std::sort(cells_.begin(), cells_.end());
+    cells_.erase(std::unique(cells_.begin(), cells_.end()), cells_.end());
+    if (++generation_ == 0) {
+      std::fill(stamp_.begin(), stamp_.end(), 0u);
+      generation_ = 1;
+    }
+    for (std::uint32_t c : cells_) {
+      for (std::uint32_t i = begin_[c]; i < begin_[c + 1]; ++i) {
+        const std::uint32_t local = items_[i];
+        if (stamp_[local] == generation_) continue;
+        stamp_[local] = generation_;
+        seen.push_back(facets_[local]);
+      }
+    }
+    for (std::uint32_t f : seen) {
+      const auto [a, b, c] = corners(f);
+      const Eigen::Vector3d v[3] = {a, b, c};
+      double d[3];
+      for (int i = 0; i < 3; ++i) d[i] = (v[i].head<2>() - base).dot(t);
+      Eigen::Vector2d ends[2];  // (u, z)
+      int found = 0;
+      for (int i = 0; i < 3 && found < 2; ++i) {
+        const int j = (i + 1) % 3;
+        if ((d[i] < 0) == (d[j] < 0)) continue;
+        const double s = d[i] / (d[i] - d[j]);
+        const Eigen::Vector3d q = v[i] + s * (v[j] - v[i]);
+        ends[found++] = Eigen::Vector2d((q.head<2>() - base).dot(n), q.z());
+      }
+      if (found < 2) continue;
+      clip_and_add(ends[0], ends[1], u_min, u_max, out);
+    }
+  }
+
+ private:
+  static int clampi(double v, int n) { return std::clamp(static_cast<int>(std::floor(v)), 0, n - 1); }
+
+  std::array<Eigen::Vector3d, 3> corners(std::size_t f) const {
+    const auto& tri = mesh_.faces[f];
+    return {mesh_.vertices[static_cast<std::size_t>(tri[0])], mesh_.vertices[static_cast<std::size_t>(tri[1])],
+            mesh_.vertices[static_cast<std::size_t>(tri[2])]};
+  }
+
+  // Clip the segment a–b (u, z) to the layer's z range and the u window; add its ends.
+  void clip_and_add(Eigen::Vector2d a, Eigen::Vector2d b, double u_min, double u_max, std::vector<ProfileBound>& out) const {
+    double t0 = 0.0, t1 = 1.0;
+    const Eigen::Vector2d d = b - a;
+    auto clip = [&](double p, double q) {  // keep where p·t ≤ q
+      if (std::abs(p) < 1e-300) return q >= 0;
+      const double r = q / p;
+      if (p < 0) t0 = std::max(t0, r); else t1 = std::min(t1, r);
+      return t0 <= t1;
+    };
+    if (!clip(-d.y(), a.y() - zb_) || !clip(d.y(), zt_ - a.y()) || !clip(-d.x(), a.x() - u_min) || !clip(d.x(), u_max - a.x())) return;
+    const Eigen::Vector2d p = a + t0 * d, q = a + t1 * d;
+    out.push_back({p.y(), p.x()});
+    out.push_back({q.y(), q.x()});
+  }
+
+  const Mesh& mesh_;
+  double zb_, zt_;
+  std::vector<std::uint32_t> facets_;
+  Eigen::Vector2d origin_{0, 0};
+  double cell_ = 1.0;
+  int nx_ = 0, ny_ = 0;
+  std::vector<std::uint32_t> begin_, items_;  // CSR: cell → index into facets_
+  // Per-query scratch: one SlabFacets serves one layer on one thread.
+  mutable std::vector<std::uint32_t> stamp_, cells_;
+  mutable std::uint32_t generation_ = 0;
+};
+
+// The union of every sub-slice's material and the shadows between them: what a vertical
+// outside cut keeps. Outer rings CCW, holes CW, holes linked to their outer ring.
+std::vector<OutlineRing> layer_outline_rings(const std::vector<const Slice*>& sub_slices, ClipperLib::Paths all,
+                                             double min_hole_width_mm) {
+  for (const Slice* s : sub_slices) {
+    for (const Loop& l : s->loops) all.push_back(detail::to_clipper(l.points));
+  }
+  ClipperLib::Clipper clipper;
+  clipper.AddPaths(all, ClipperLib::ptSubject, true);
+  ClipperLib::PolyTree tree;
+  clipper.Execute(ClipperLib::ctUnion, tree, ClipperLib::pftPositive, ClipperLib::pftPositive);
+  std::vector<OutlineRing> rings;
+  // Drop vertices closer than 0.1 µm and collinear runs: unions of near-identical sub-slices
+  // leave such crumbs, and every vertex becomes a station.
+  auto add = [&](const ClipperLib::PolyNode& node, int parent) {
+    ClipperLib::Path path = node.Contour;
+    ClipperLib::CleanPolygon(path, 100.0);
+    if (path.size() < 3) return -1;
+    OutlineRing r;
+    r.points = detail::from_clipper(path);
+    r.is_hole = node.IsHole();
+    r.parent = parent;
+    const double area = std::abs(signed_area_mm2(r.points));
+    if (area < 1e-8) return -1;
+    if (r.is_hole) {
+      // Mean width of the hole (2·area / perimeter): slivers between sub-slices that no jet can
+      // cut are left closed — keeping material there is on the safe side of "outside".
+      double perimeter = 0.0;
+      for (std::size_t i = 0; i < r.points.size(); ++i) perimeter += (r.points[(i + 1) % r.points.size()] - r.points[i]).norm();
+      if (2.0 * area / perimeter < min_hole_width_mm) return -2;
+    }
+    rings.push_back(std::move(r));
+    return static_cast<int>(rings.size()) - 1;
+  };
+  std::vector<std::pair<const ClipperLib::PolyNode*, int>> stack;
+  for (const ClipperLib::PolyNode* child : tree.Childs) stack.emplace_back(child, -1);
+  while (!stack.empty()) {
+    auto [node, parent] = stack.back();
+    stack.pop_back();
+    const int self = add(*node, node->IsHole() ? parent : -1);
+    if (self == -2) continue;  // a closed sliver: what lies inside it is inside the material
+    // Holes belong to the outer above them; islands inside a hole are new outers.
+    for (const ClipperLib::PolyNode* child : node->Childs) stack.emplace_back(child, node->IsHole() ? -1 : self);
+  }
+  return rings;
+}
+
+struct StationSeed {
+  Eigen::Vector2d point, normal;
+};
+
+// Stations: every ring vertex (normal: bisector of its edges' normals) and extra points on edges
+// longer than the spacing (normal: the edge's). Normals point out of the material for outer and
+// hole rings alike (material is on the left of the ring's direction).
+std::vector<StationSeed> station_seeds(const Polygon2& ring, double spacing_mm) {
+  const std::size_t n = ring.size();
+  std::vector<Eigen::Vector2d> edge_normal(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Eigen::Vector2d e = ring[(i + 1) % n] - ring[i];
+    const double len = e.norm();
+    edge_normal[i] = len > 0 ? Eigen::Vector2d(e.y() / len, -e.x() / len) : Eigen::Vector2d::Zero();
+  }
+  std::vector<StationSeed> seeds;
+  seeds.reserve(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    Eigen::Vector2d nrm = edge_normal[(i + n - 1) % n] + edge_normal[i];
+    nrm = nrm.norm() > 1e-12 ? nrm.normalized() : edge_normal[i];
+    seeds.push_back({ring[i], nrm});
+    const Eigen::Vector2d a = ring[i], b = ring[(i + 1) % n];
+    const double len = (b - a).norm();
+    const int extra = spacing_mm > 0 ? static_cast<int>(std::ceil(len / spacing_mm)) - 1 : 0;
+    for (int k = 1; k <= extra; ++k) {
+      const double t = static_cast<double>(k) / (extra + 1);
+      seeds.push_back({a + t * (b - a), edge_normal[i]});
+    }
+  }
+  return seeds;
+}
+
+double wrap_near(double angle, double reference) {
+  // The representative of angle (mod 2π) closest to reference: C never jumps by a turn.
+  const double two_pi = 2.0 * M_PI;
+  return angle + two_pi * std::round((reference - angle) / two_pi);
+}
+
+CutLine make_line(const CutStation& st, const CutLine1D& cut, double zb, double zt, const Eigen::Vector3d& paper_v) {
+  CutLine line;
+  const Eigen::Vector2d top = st.base_mm + cut.u_top_mm * st.normal;
+  const Eigen::Vector2d bottom = st.base_mm + cut.u_bottom_mm * st.normal;
+  line.top_mm = Eigen::Vector3d(top.x(), top.y(), zt);
+  line.bottom_mm = Eigen::Vector3d(bottom.x(), bottom.y(), zb);
+  line.tool_axis = (line.top_mm - line.bottom_mm).normalized();
+  const double xy = std::hypot(line.tool_axis.x(), line.tool_axis.y());
+  line.tilt_rad = std::atan2(xy, line.tool_axis.z());
+  line.c_rad = std::atan2(line.tool_axis.y(), line.tool_axis.x());
+  line.paper_v = paper_v;
+  if (paper_v.squaredNorm() > 0) {
+    const double vxy = std::hypot(paper_v.x(), paper_v.y());
+    line.paper_a_deg = 180.0 - std::atan2(vxy, paper_v.z()) * 180.0 / M_PI;
+    line.paper_c_deg = std::atan2(paper_v.y(), paper_v.x()) * 180.0 / M_PI;
+  }
+  return line;
+}
+
+// Make C continuous along a closed pass: unwrap against the previous line, and hold it where the
+// axis is vertical (C is undefined there; holding it avoids a needless head swing).
+void unwind_c(CutPass& pass) {
+  constexpr double kVertical = 1e-6;
+  double reference = 0.0;
+  for (const auto& l : pass.lines) {
+    if (l.tilt_rad > kVertical) { reference = l.c_rad; break; }
+  }
+  for (auto& l : pass.lines) {
+    if (l.tilt_rad <= kVertical) {
+      l.c_rad = reference;
+    } else {
+      l.c_rad = wrap_near(l.c_rad, reference);
+      reference = l.c_rad;
+    }
+  }
+}
+
+// The outline as a section, to find how far out a line may go before it meets other material
+// of the same layer.
+Slice outline_section(const std::vector<OutlineRing>& rings) {
+  Slice outline_slice;
+  for (const OutlineRing& ring : rings) {
+    Loop loop;
+    loop.points = ring.points;
+    loop.facets.assign(ring.points.size(), -1);
+    loop.area_mm2 = signed_area_mm2(ring.points);
+    outline_slice.loops.push_back(std::move(loop));
+  }
+  return outline_slice;
+}
+
+// The outline here comes from material between sub-slices (a shadow), which the profile cannot
+// see: only the vertical cut on the outline is sure to stay outside.
+constexpr double kOnOutline = 1e-3;  // the outline went through Clipper (1 nm grid), cleaned at 0.1 µm
+
+// What one layer's stations read: its sub-slices' lines, the facets between them, the outline.
+struct StationContext {
+  const std::vector<SectionLines>& lines;
+  const SlabFacets& slab;
+  const SectionLines& outline_lines;
+  const std::vector<double>& zs;
+  double zb, zt, reach;
+  const BevelParams& params;
+  std::vector<ProfileSample> samples;
+  std::vector<ProfileBound> trace;
+  std::vector<std::uint32_t> scratch;
+};
+
+struct StationPlan {
+  CutStation station;
+  ProfileFit fit;
+  Eigen::Vector3d paper_v = Eigen::Vector3d::Zero();  // the paper's V = N × C
+};
+
+StationPlan plan_station(const StationSeed& seed, StationContext& cx) {
+  StationPlan out;
+  CutStation& st = out.station;
+  st.base_mm = seed.point;
+  st.normal = seed.normal;
+  Eigen::Vector3d top_normal = Eigen::Vector3d::Zero();
+  for (std::size_t j = 0; j < cx.zs.size(); ++j) {
+    ProfileSample& s = cx.samples[j];
+    s.z_mm = cx.zs[j];
+    const auto hit = cx.lines[j].exit_crossing(seed.point, seed.normal, -cx.reach, kOnOutline, CrossingPick::largest);
+    s.present = hit.has_value();
+    if (hit) {
+      s.u_mm = hit->u_mm;
+      s.slope = profile_slope(hit->normal, seed.normal);
+      st.surface_id = hit->surface_id;
+      top_normal = hit->normal;
+    }
+  }
+  cx.slab.trace(seed.point, seed.normal, -cx.reach, kOnOutline, cx.trace, cx.scratch);
+  // Walking out along the normal, the next material of the layer (leaving it along −n).
+  double ceiling = std::numeric_limits<double>::infinity();
+  if (const auto next = cx.outline_lines.exit_crossing(seed.point, -seed.normal, -cx.reach, -2 * kOnOutline,
+                                                       CrossingPick::largest))
+    ceiling = -next->u_mm - kOnOutline;
+  out.fit = fit_profile(cx.samples, cx.zb, cx.zt, cx.params.fit, cx.trace, ceiling);
+  double outermost = -std::numeric_limits<double>::infinity();
+  for (const auto& smp : cx.samples)
+    if (smp.present) outermost = std::max(outermost, smp.u_mm);
+  if (out.fit.cuts.empty() || outermost < -kOnOutline) {  // a shadow: the vertical cut on the outline
+    const double gap = std::isfinite(outermost) ? -outermost : 0.0;
+    out.fit.cuts.assign(1, CutLine1D{0.0, 0.0});
+    out.fit.max_deviation_mm = std::max(out.fit.max_deviation_mm, gap);
+  }
+  st.shape = out.fit.shape;
+  st.slope_rule_agrees = out.fit.slope_rule_agrees;
+  st.tilt_limited = out.fit.tilt_limited;
+  st.max_deviation_mm = out.fit.max_deviation_mm;
+  // The paper's V = N × C: C along the contour (material on its left), N the facet normal.
+  const Eigen::Vector3d c_dir(-seed.normal.y(), seed.normal.x(), 0.0);
+  const Eigen::Vector3d v = top_normal.cross(c_dir);
+  out.paper_v = v.norm() > 1e-12 ? Eigen::Vector3d(v.normalized()) : Eigen::Vector3d::Zero();
+  return out;
+}
+
+// The outline's passes: as many as its station with the most cuts; stations with one cut repeat
+// it, so every pass is a closed loop around the outline.
+void make_passes(LayerOutline& outline, const std::vector<ProfileFit>& fits, const std::vector<Eigen::Vector3d>& paper_vs,
+                 double zb, double zt) {
+  std::size_t pass_count = 1;
+  for (const auto& f : fits) pass_count = std::max(pass_count, f.cuts.size());
+  outline.passes.resize(pass_count);
+  for (std::size_t p = 0; p < pass_count; ++p) {
+    CutPass& pass = outline.passes[p];
+    pass.lines.reserve(fits.size());
+    for (std::size_t s = 0; s < fits.size(); ++s) {
+      const auto& cuts = fits[s].cuts;
+      const CutLine1D& cut = cuts[std::min(p * cuts.size() / pass_count, cuts.size() - 1)];
+      pass.lines.push_back(make_line(outline.stations[s], cut, zb, zt, paper_vs[s]));
+    }
+    unwind_c(pass);
+  }
+}
+
+LayerOutline plan_outline(const OutlineRing& ring, StationContext& cx, LayerPlan& plan) {
+  LayerOutline outline;
+  outline.is_hole = ring.is_hole;
+  outline.parent = ring.parent;
+  const auto seeds = station_seeds(ring.points, cx.params.station_spacing_mm);
+  std::vector<ProfileFit> fits;
+  std::vector<Eigen::Vector3d> paper_vs;
+  fits.reserve(seeds.size());
+  for (const StationSeed& seed : seeds) {
+    StationPlan sp = plan_station(seed, cx);
+    outline.max_deviation_mm = std::max(outline.max_deviation_mm, sp.fit.max_deviation_mm);
+    ++plan.shape_counts[static_cast<std::size_t>(sp.fit.shape)];
+    paper_vs.push_back(sp.paper_v);
+    outline.stations.push_back(sp.station);
+    fits.push_back(std::move(sp.fit));
+  }
+  make_passes(outline, fits, paper_vs, cx.zb, cx.zt);
+  return outline;
+}
+
+LayerPlan plan_layer(const Mesh& mesh, const LayerSpan& span, int index, const std::vector<double>& zs,
+                     const std::vector<const Slice*>& sub_slices, const BevelParams& params) {
+  LayerPlan plan;
+  plan.index = index;
+  plan.z_bottom_mm = span.z_bottom_mm;
+  plan.thickness_mm = span.thickness_mm;
+  plan.sub_slice_z_mm = zs;
+
+  std::vector<SectionLines> lines;
+  lines.reserve(sub_slices.size());
+  for (const Slice* s : sub_slices) lines.emplace_back(mesh, *s);
+  // How far in a sample may lie and still be this station's surface: what a line at the tilt
+  // limit reaches across the layer, plus a sub-slice of slack. Further in, the surface has
+  // turned (nearly) horizontal: the sample counts as absent and the profile gets a ledge.
+  const double tan_max = std::tan(std::min(params.fit.tilt_max_rad, 1.5));
+  const double reach = span.thickness_mm * std::max(tan_max, 1.0) + 2.0 * params.sub_slice_mm;
+  const SlabFacets slab(mesh, zs.front(), zs.back(), params.station_spacing_mm);
+  const auto rings = layer_outline_rings(sub_slices, facet_shadows(mesh, zs, lines), params.min_hole_width_mm);
+  const SectionLines outline_lines(mesh, outline_section(rings));
+  StationContext cx{lines, slab, outline_lines, zs, span.z_bottom_mm, span.z_top_mm(), reach, params,
+                    std::vector<ProfileSample>(zs.size()), {}, {}};
+  for (const OutlineRing& ring : rings) {
+    LayerOutline outline = plan_outline(ring, cx, plan);
+    plan.passes = std::max(plan.passes, static_cast<int>(outline.passes.size()));
+    plan.max_deviation_mm = std::max(plan.max_deviation_mm, outline.max_deviation_mm);
+    plan.outlines.push_back(std::move(outline));
+  }
+  if (params.fit.side == CutSide::outside) {
+    const detail::GougeClearance g = detail::clear_gouges(plan, sub_slices, reach);
+    plan.gouge_shift_mm = g.largest_shift_mm;
+    plan.gouge_left_mm = g.worst_left_mm;
+  }
+  plan.within_tolerance = plan.max_deviation_mm <= params.tolerance_mm;
+  return plan;
+}
+
+}  // namespace
+
+std::expected<BevelPlan, Error> plan_bevels(const Mesh& mesh, std::span<const LayerSpan> layers,
+                                            const BevelParams& params) {
+  return detail::plan_bevels_on(mesh, nullptr, layers, params);
+}
+
+std::expected<BevelPlan, Error> detail::plan_bevels_on(const Mesh& mesh, const TriangleTree* model_tree,
+                                                       std::span<const LayerSpan> layers, const BevelParams& params) {
+  if (!(params.sub_slice_mm > 0.0) || !std::isfinite(params.sub_slice_mm)) {
+    return std::unexpected(Error{ErrorCode::invalid_argument, fmt::format("sub-slice spacing must be > 0 mm (got {})", params.sub_slice_mm)});
+  }
+  if (!(params.fit.tilt_max_rad >= 0.0) || params.fit.tilt_max_rad >= 0.5 * M_PI) {
+    return std::unexpected(Error{ErrorCode::invalid_argument, fmt::format("tilt limit must be in [0°, 90°) (got {:.3f}°)", params.fit.tilt_max_rad * 180.0 / M_PI)});
+  }
+  std::vector<double> all_z;
+  std::vector<std::size_t> first(layers.size() + 1, 0);
+  std::vector<std::vector<double>> layer_z(layers.size());
+  for (std::size_t i = 0; i < layers.size(); ++i) {
+    const auto& l = layers[i];
+    if (!(l.thickness_mm > 0.0) || !std::isfinite(l.z_bottom_mm)) {
+      return std::unexpected(Error{ErrorCode::invalid_argument, fmt::format("layer {}: thickness must be > 0 mm (got {})", i, l.thickness_mm)});
+    }
+    if (i > 0 && l.z_bottom_mm < layers[i - 1].z_top_mm() - 1e-9) {
+      return std::unexpected(Error{ErrorCode::invalid_argument,
+                                   fmt::format("layer {} starts at z = {} mm, below the top of layer {} ({} mm)", i, l.z_bottom_mm, i - 1, layers[i - 1].z_top_mm())});
+    }
+    layer_z[i] = sub_slice_heights(l.z_bottom_mm, l.thickness_mm, params.sub_slice_mm);
+    first[i] = all_z.size();
+    all_z.insert(all_z.end(), layer_z[i].begin(), layer_z[i].end());
+  }
+  first[layers.size()] = all_z.size();
+  SliceParams slice_params;
+  slice_params.parallel = params.parallel;
+  auto slices = slice_mesh(mesh, all_z, slice_params);
+  if (!slices) return std::unexpected(slices.error());
+
+  BevelPlan plan;
+  plan.fit = params.fit;
+  plan.layers.resize(layers.size());
+  std::optional<detail::TriangleTree> own_tree;
+  const detail::TriangleTree* model = model_tree;
+  if (params.measure_surface_distance && !layers.empty() && !model) {
+    own_tree.emplace(mesh.vertices, mesh.faces, params.parallel);
+    model = &*own_tree;
+  }
+  if (!params.measure_surface_distance) model = nullptr;
+  double model_z_lo = std::numeric_limits<double>::infinity(), model_z_hi = -model_z_lo;
+  if (model)
+    for (const Eigen::Vector3d& v : mesh.vertices) model_z_lo = std::min(model_z_lo, v.z()), model_z_hi = std::max(model_z_hi, v.z());
+  auto one = [&](std::size_t i) {
+    std::vector<const Slice*> subs;
+    for (std::size_t k = first[i]; k < first[i + 1]; ++k) subs.push_back(&(*slices)[k]);
+    LayerPlan& layer = plan.layers[i];
+    layer = plan_layer(mesh, layers[i], static_cast<int>(i), layer_z[i], subs, params);
+    layer.profile_deviation_mm = layer.max_deviation_mm;
+    if (!model) return;
+    // What the tolerance checks is the 3-D distance (issue 17, item 4): a station's plane can
+    // neither see a corner that slides along the outline nor the true (normal) distance to a
+    // sloped surface.
+    layer.surface_distance_mm = detail::layer_surface_distance(*model, model_z_lo, model_z_hi, layer, subs, params.distance_sample_mm);
+    layer.max_deviation_mm = layer.surface_distance_mm;
+    layer.within_tolerance = layer.max_deviation_mm <= params.tolerance_mm;
+  };
+  if (params.parallel) {
+    tbb::parallel_for(std::size_t{0}, layers.size(), one);
+  } else {
+    for (std::size_t i = 0; i < layers.size(); ++i) one(i);
+  }
+  return plan;
+}
+
+}  // namespace lamina

@@ -1,0 +1,207 @@
+// Keeping outside cuts off the model's material between stations (bevel_gouge.hpp).
+#include "bevel/bevel_gouge.hpp"
+
+#include "geometry/clipper_bridge.hpp"
+#include "geometry/stack_geometry.hpp"
+
+#include <polyclipping/clipper.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace lamina::detail {
+namespace {
+
+// Moving a station changes its neighbours' chords too: a few rounds settle every corner.
+constexpr int kRounds = 6;
+// A chord that faces away from both its stations' normals moves slowly when they move; below
+// this the shift is computed as if it moved at this rate (and the next round checks again).
+constexpr double kMinChordRate = 0.25;
+// Pieces of material outside the cuts with less area than this are rounding slivers.
+constexpr double kMinPieceArea = 1e-8;
+
+ClipperLib::Paths material_of(const Slice& slice) {
+  ClipperLib::Paths loops;
+  for (const Loop& l : slice.loops) loops.push_back(to_clipper(l.points));
+  ClipperLib::Clipper c;
+  c.AddPaths(loops, ClipperLib::ptSubject, true);
+  ClipperLib::Paths out;
+  c.Execute(ClipperLib::ctUnion, out, ClipperLib::pftPositive, ClipperLib::pftPositive);
+  return out;
+}
+
+struct Chord {
+  int outline;
+  std::size_t a, b;  // stations
+  Eigen::Vector2d pa, pb;
+  Eigen::Vector2d lo, hi;  // bounding box
+};
+
+std::vector<Chord> chords_at(const LayerPlan& layer, double z) {
+  std::vector<Chord> out;
+  const double t = layer_t(layer, z);
+  for (std::size_t o = 0; o < layer.outlines.size(); ++o) {
+    const LayerOutline& outline = layer.outlines[o];
+    if (!outline_usable(outline)) continue;
+    const Polygon2 ring = edge_ring(outline, t);
+    for (std::size_t a = 0; a < ring.size(); ++a) {
+      const std::size_t b = (a + 1) % ring.size();
+      if ((ring[b] - ring[a]).norm() < 1e-9) continue;
+      out.push_back({static_cast<int>(o), a, b, ring[a], ring[b], ring[a].cwiseMin(ring[b]), ring[a].cwiseMax(ring[b])});
+    }
+  }
+  return out;
+}
+
+double distance_to(const Eigen::Vector2d& q, const Chord& c) {
+  const Eigen::Vector2d d = c.pb - c.pa;
+  const double s = std::clamp((q - c.pa).dot(d) / d.squaredNorm(), 0.0, 1.0);
+  return (c.pa + s * d - q).norm();
+}
+
+const Chord* nearest_chord(const Eigen::Vector2d& q, const std::vector<Chord>& chords, double& best) {
+  const Chord* nearest = nullptr;
+  best = std::numeric_limits<double>::infinity();
+  for (const Chord& c : chords) {
+    const Eigen::Vector2d gap = (c.lo - q).cwiseMax(q - c.hi).cwiseMax(0.0);
+    if (gap.norm() >= best) continue;
+    const double d = distance_to(q, c);
+    if (d < best) {
+      best = d;
+      nearest = &c;
+    }
+  }
+  return nearest;
+}
+
+// Finds material of the sub-slices outside the layer's section; for each piece's vertices the
+// chord they lie beyond and how far each of its stations must move out. Returns the deepest.
+double find_gouges(const LayerPlan& layer, const std::vector<const Slice*>& sub_slices,
+                   const std::vector<ClipperLib::Paths>& material, std::vector<std::vector<double>>* shift) {
+  double worst = 0.0;
+  for (std::size_t j = 0; j < sub_slices.size(); ++j) {
+    const double z = sub_slices[j]->z_mm;
+    ClipperLib::Clipper c;
+    c.AddPaths(material[j], ClipperLib::ptSubject, true);
+    c.AddPaths(to_clipper(layer_section(layer, z)), ClipperLib::ptClip, true);
+    ClipperLib::Paths outside;
+    c.Execute(ClipperLib::ctDifference, outside, ClipperLib::pftPositive, ClipperLib::pftPositive);
+    if (outside.empty()) continue;
+    const std::vector<Chord> chords = chords_at(layer, z);
+    for (const ClipperLib::Path& piece : outside) {
+      if (std::abs(ClipperLib::Area(piece)) < kMinPieceArea * kClipperUnitsPerMm * kClipperUnitsPerMm) continue;
+      for (const Eigen::Vector2d& q : from_clipper(piece)) {
+        double d = 0.0;
+        const Chord* ch = nearest_chord(q, chords, d);
+        if (!ch || d <= kGougeTolerance) continue;
+        // Material lies on the left of every ring's direction: the scrap side is the right.
+        const Eigen::Vector2d dir = (ch->pb - ch->pa).normalized();
+        const Eigen::Vector2d scrap(dir.y(), -dir.x());
+        const double depth = (q - ch->pa).dot(scrap);
+        if (depth <= kGougeTolerance) continue;  // not beyond this chord: nothing a move here mends
+        worst = std::max(worst, depth);
+        if (!shift) continue;
+        const LayerOutline& outline = layer.outlines[static_cast<std::size_t>(ch->outline)];
+        const double rate = std::max(kMinChordRate, std::min(outline.stations[ch->a].normal.dot(scrap),
+                                                             outline.stations[ch->b].normal.dot(scrap)));
+        const double need = depth / rate + kGougeTolerance;
+        auto& s = (*shift)[static_cast<std::size_t>(ch->outline)];
+        s[ch->a] = std::max(s[ch->a], need);
+        s[ch->b] = std::max(s[ch->b], need);
+      }
+    }
+  }
+  return worst;
+}
+
+void move_station(LayerOutline& outline, std::size_t s, double by_mm) {
+  const Eigen::Vector2d n = outline.stations[s].normal;
+  for (CutPass& pass : outline.passes) {
+    CutLine& l = pass.lines[s];
+    l.top_mm.head<2>() += by_mm * n;
+    l.bottom_mm.head<2>() += by_mm * n;
+  }
+  outline.stations[s].max_deviation_mm += by_mm;
+  outline.max_deviation_mm = std::max(outline.max_deviation_mm, outline.stations[s].max_deviation_mm);
+}
+
+// How deep q lies inside the material (0 outside or on its boundary).
+double depth_inside(const Eigen::Vector2d& q, const ClipperLib::Paths& material) {
+  const ClipperLib::IntPoint p(static_cast<ClipperLib::cInt>(std::llround(q.x() * kClipperUnitsPerMm)),
+                               static_cast<ClipperLib::cInt>(std::llround(q.y() * kClipperUnitsPerMm)));
+  int winding = 0;
+  for (const ClipperLib::Path& path : material)
+    if (ClipperLib::PointInPolygon(p, path) == 1) winding += ClipperLib::Orientation(path) ? 1 : -1;
+  if (winding <= 0) return 0.0;
+  double nearest = std::numeric_limits<double>::infinity();
+  for (const ClipperLib::Path& path : material) {
+    const std::vector<Eigen::Vector2d> ring = from_clipper(path);
+    for (std::size_t i = 0; i < ring.size(); ++i) {
+      const Chord edge{0, 0, 0, ring[i], ring[(i + 1) % ring.size()], {}, {}};
+      if ((edge.pb - edge.pa).squaredNorm() > 0) nearest = std::min(nearest, distance_to(q, edge));
+    }
+  }
+  return nearest;
+}
+
+// A station moved out of one corner's material must not have moved into other material (a
+// strand of a knot beside it, another outline of the section): its lines are checked at every
+// sub-slice; a move that enters material is undone, and the gouge it was for stays reported.
+bool enters_material(const LayerOutline& outline, std::size_t s, const std::vector<const Slice*>& sub_slices,
+                     const std::vector<ClipperLib::Paths>& material) {
+  for (const CutPass& pass : outline.passes) {
+    const CutLine& l = pass.lines[s];
+    const double dz = l.top_mm.z() - l.bottom_mm.z();
+    for (std::size_t j = 0; j < sub_slices.size(); ++j) {
+      const double f = std::abs(dz) > 1e-12 ? (sub_slices[j]->z_mm - l.bottom_mm.z()) / dz : 0.0;
+      const Eigen::Vector2d q = (l.bottom_mm + std::clamp(f, 0.0, 1.0) * (l.top_mm - l.bottom_mm)).head<2>();
+      if (depth_inside(q, material[j]) > kGougeTolerance) return true;
+    }
+  }
+  return false;
+}
+
+}  // namespace
+
+GougeClearance clear_gouges(LayerPlan& layer, const std::vector<const Slice*>& sub_slices, double max_shift_mm) {
+  GougeClearance r;
+  std::vector<ClipperLib::Paths> material;
+  material.reserve(sub_slices.size());
+  for (const Slice* s : sub_slices) material.push_back(material_of(*s));
+
+  std::vector<std::vector<double>> moved(layer.outlines.size()), shift(layer.outlines.size());
+  for (std::size_t o = 0; o < layer.outlines.size(); ++o) moved[o].assign(layer.outlines[o].stations.size(), 0.0);
+  for (int round = 0; round < kRounds; ++round) {
+    for (std::size_t o = 0; o < layer.outlines.size(); ++o) shift[o].assign(layer.outlines[o].stations.size(), 0.0);
+    const double worst = find_gouges(layer, sub_slices, material, &shift);
+    if (round == 0) r.worst_found_mm = worst;
+    bool any = false;
+    for (std::size_t o = 0; o < layer.outlines.size(); ++o) {
+      for (std::size_t s = 0; s < shift[o].size(); ++s) {
+        const double by = std::min(shift[o][s], max_shift_mm - moved[o][s]);
+        if (!(by > 0.0)) continue;
+        if (moved[o][s] == 0.0) ++r.stations_moved;
+        moved[o][s] += by;
+        r.largest_shift_mm = std::max(r.largest_shift_mm, moved[o][s]);
+        move_station(layer.outlines[o], s, by);
+        any = true;
+      }
+    }
+    if (!any) break;
+  }
+  for (std::size_t o = 0; o < layer.outlines.size(); ++o) {
+    for (std::size_t s = 0; s < moved[o].size(); ++s) {
+      if (moved[o][s] > 0.0 && enters_material(layer.outlines[o], s, sub_slices, material)) {
+        move_station(layer.outlines[o], s, -moved[o][s]);
+        ++r.moves_undone;
+      }
+    }
+  }
+  r.worst_left_mm = r.stations_moved > 0 ? find_gouges(layer, sub_slices, material, nullptr) : r.worst_found_mm;
+  for (const LayerOutline& outline : layer.outlines)
+    layer.max_deviation_mm = std::max(layer.max_deviation_mm, outline.max_deviation_mm);
+  return r;
+}
+
+}  // namespace lamina::detail

@@ -1,0 +1,132 @@
+// The layering chooses from what the plan will measure (issue 17, item 4). The grid estimate
+// reads each layer at a few stations on its faces; the bevel planner reads it at every station of
+// every sub-slice, and where a surface turns across the layer (a twisted prism) the two disagreed
+// both ways: 0.010 estimated vs 0.28 mm measured for 2.5 mm layers, 1.085 vs 0.375 for 5 mm.
+//
+// So the estimate is only the DP's first guess. Every layer the DP chooses is planned by the bevel
+// planner itself (plan_bevels, the same parameters the plan will use) and its measure replaces
+// the estimate; the DP runs again on the corrected values until the layers it chooses are all
+// measured ones. Each round measures at least one new layer, so it ends; kMaxRounds bounds it
+// (the last choice is then kept, its unmeasured layers flagged by estimate != measure in the
+// report). A round costs one plan_bevels of the chosen layers and a DP over memoized estimates.
+//
+// Estimates that were too pessimistic are corrected too: in every round, at each chosen layer's
+// start that is within tolerance, the next thicker sheet is planned as well (kept out of the DP's way of overlaps by
+// planning the thicker layers in separate, non-overlapping batches).
+#include "layering/layering_internal.hpp"
+
+#include "bevel/bevel_distance.hpp"
+#include "lamina/core/bevel.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <optional>
+
+namespace lamina::layering_detail {
+
+namespace {
+
+constexpr int kMaxRounds = 12;
+
+BevelParams bevel_params_of(const LayeringParams& params) {
+  BevelParams p;
+  p.fit = params.fit;
+  p.sub_slice_mm = params.sub_slice_mm;
+  p.tolerance_mm = params.tolerance_mm;
+  p.parallel = params.parallel;
+  return p;
+}
+
+struct Candidate {
+  double z_rel = 0.0;
+  int thickness_index = 0;
+};
+
+// The plans made, by (start in µm, thickness index): the chosen layers' plans are handed on.
+using PlanCache = std::map<std::pair<std::int64_t, int>, LayerPlan>;
+std::pair<std::int64_t, int> plan_key(double z_rel, int thickness_index) {
+  return {std::llround(z_rel * 1e6), thickness_index};
+}
+
+// Plans the candidates (in batches of layers that do not overlap) and records each measure.
+// Returns how many were new.
+std::expected<int, Error> measure(Estimator& est, const Mesh& mesh, const detail::TriangleTree& model,
+                                  const LayeringParams& params, std::vector<Candidate> todo, PlanCache& plans) {
+  const std::vector<double>& t = est.thicknesses();
+  std::sort(todo.begin(), todo.end(), [](const Candidate& a, const Candidate& b) { return a.z_rel < b.z_rel; });
+  int fresh = 0;
+  while (!todo.empty()) {
+    std::vector<Candidate> batch, rest;
+    double free_from = -1e300;  // the top of the batch's last layer
+    for (const Candidate& c : todo) {
+      if (c.z_rel < free_from - 1e-9) {
+        rest.push_back(c);
+        continue;
+      }
+      batch.push_back(c);
+      free_from = c.z_rel + t[static_cast<std::size_t>(c.thickness_index)];
+    }
+    std::vector<LayerSpan> spans;
+    for (const Candidate& c : batch)
+      spans.push_back(LayerSpan{est.z_base() + c.z_rel, t[static_cast<std::size_t>(c.thickness_index)]});
+    auto plan = detail::plan_bevels_on(mesh, &model, spans, bevel_params_of(params));
+    if (!plan) return std::unexpected(plan.error());
+    for (std::size_t i = 0; i < batch.size(); ++i) {
+      const GridSpan span = est.span(batch[i].z_rel, t[static_cast<std::size_t>(batch[i].thickness_index)]);
+      fresh += est.set_measured(span, batch[i].thickness_index, plan->layers[i].max_deviation_mm) ? 1 : 0;
+      plans.insert_or_assign(plan_key(batch[i].z_rel, batch[i].thickness_index), std::move(plan->layers[i]));
+    }
+    todo = std::move(rest);
+  }
+  return fresh;
+}
+
+// The chosen layers not measured yet, and at each chosen layer's start the next thicker sheet.
+std::vector<Candidate> unmeasured(const Estimator& est, const LayerChoice& choice) {
+  const std::vector<double>& t = est.thicknesses();
+  std::vector<Candidate> out;
+  for (const ChosenLayer& l : choice.layers) {
+    const int i = l.thickness_index;
+    if (!est.is_measured(est.span(l.z_rel, t[static_cast<std::size_t>(i)]), i)) out.push_back({l.z_rel, i});
+    // Where the chosen sheet itself is out of tolerance a thicker one will not do better.
+    const int thicker = i + 1;
+    if (l.within && thicker < static_cast<int>(t.size()) && l.z_rel + t[static_cast<std::size_t>(thicker)] <= est.height() + 1e-9 &&
+        !est.is_measured(est.span(l.z_rel, t[static_cast<std::size_t>(thicker)]), thicker))
+      out.push_back({l.z_rel, thicker});
+  }
+  return out;
+}
+
+}  // namespace
+
+std::expected<LayerChoice, Error> layer_verified(Estimator& est, const Mesh& mesh, const LayeringParams& params) {
+  LayerChoice choice = layer_optimal(est, params);
+  std::optional<detail::TriangleTree> model;  // built once, for every round's plans
+  PlanCache plans;
+  for (int round = 0; round < kMaxRounds; ++round) {
+    if (choice.layers.empty() || choice.state_limit) break;
+    const std::vector<Candidate> todo = unmeasured(est, choice);
+    if (todo.empty()) break;  // every chosen layer stands on its measure
+    if (!model) model.emplace(mesh.vertices, mesh.faces, params.parallel);
+    auto fresh = measure(est, mesh, *model, params, todo, plans);
+    if (!fresh) return std::unexpected(fresh.error());
+    if (params.on_round) params.on_round(round + 1, kMaxRounds);
+    if (*fresh == 0) break;
+    est.restart();
+    choice = layer_optimal(est, params);
+  }
+  // The chosen layers as planned, when every one was (the bevel phase need not plan them again).
+  for (std::size_t i = 0; i < choice.layers.size(); ++i) {
+    const auto it = plans.find(plan_key(choice.layers[i].z_rel, choice.layers[i].thickness_index));
+    if (it == plans.end()) {
+      choice.plans.clear();
+      break;
+    }
+    choice.plans.push_back(it->second);
+    choice.plans.back().index = static_cast<int>(i);
+  }
+  return choice;
+}
+
+}  // namespace lamina::layering_detail
