@@ -96,7 +96,7 @@ void BM_CapTriangulation(benchmark::State& state) {
   lamina::Polygon2 outer;
   for (const auto& p : ring(static_cast<int>(state.range(0)), state.range(1) != 0)) outer.push_back(p);
   for (auto _ : state) {
-    auto tris = lamina::detail::triangulate_polygon_with_holes(outer, {});
+    auto tris = lamina::geometry_detail::triangulate_polygon_with_holes(outer, {});
     benchmark::DoNotOptimize(tris.data());
   }
 }

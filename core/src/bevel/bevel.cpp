@@ -97,7 +97,7 @@ ClipperLib::Paths facet_shadows(const Mesh& mesh, const std::vector<double>& zs,
     Polygon2 ring;
     for (const auto& v : poly) ring.emplace_back(v.x(), v.y());
     if (signed_area_mm2(ring) < 0) std::reverse(ring.begin(), ring.end());
-    shadows.push_back(detail::to_clipper(ring));
+    shadows.push_back(geometry_detail::to_clipper(ring));
   }
   return shadows;
 }
@@ -238,7 +238,7 @@ class SlabFacets {
 std::vector<OutlineRing> layer_outline_rings(const std::vector<const Slice*>& sub_slices, ClipperLib::Paths all,
                                              double min_hole_width_mm) {
   for (const Slice* s : sub_slices) {
-    for (const Loop& l : s->loops) all.push_back(detail::to_clipper(l.points));
+    for (const Loop& l : s->loops) all.push_back(geometry_detail::to_clipper(l.points));
   }
   ClipperLib::Clipper clipper;
   clipper.AddPaths(all, ClipperLib::ptSubject, true);
@@ -252,7 +252,7 @@ std::vector<OutlineRing> layer_outline_rings(const std::vector<const Slice*>& su
     ClipperLib::CleanPolygon(path, 100.0);
     if (path.size() < 3) return -1;
     OutlineRing r;
-    r.points = detail::from_clipper(path);
+    r.points = geometry_detail::from_clipper(path);
     r.is_hole = node.IsHole();
     r.parent = parent;
     const double area = std::abs(signed_area_mm2(r.points));
@@ -503,7 +503,7 @@ LayerPlan plan_layer(const Mesh& mesh, const LayerSpan& span, int index, const s
     plan.outlines.push_back(std::move(outline));
   }
   if (params.fit.side == CutSide::outside) {
-    const detail::GougeClearance g = detail::clear_gouges(plan, sub_slices, reach);
+    const bevel_detail::GougeClearance g = bevel_detail::clear_gouges(plan, sub_slices, reach);
     plan.gouge_shift_mm = g.largest_shift_mm;
     plan.gouge_left_mm = g.worst_left_mm;
   }
@@ -515,10 +515,10 @@ LayerPlan plan_layer(const Mesh& mesh, const LayerSpan& span, int index, const s
 
 std::expected<BevelPlan, Error> plan_bevels(const Mesh& mesh, std::span<const LayerSpan> layers,
                                             const BevelParams& params) {
-  return detail::plan_bevels_on(mesh, nullptr, layers, params);
+  return bevel_detail::plan_bevels_on(mesh, nullptr, layers, params);
 }
 
-std::expected<BevelPlan, Error> detail::plan_bevels_on(const Mesh& mesh, const TriangleTree* model_tree,
+std::expected<BevelPlan, Error> bevel_detail::plan_bevels_on(const Mesh& mesh, const TriangleTree* model_tree,
                                                        std::span<const LayerSpan> layers, const BevelParams& params) {
   if (!(params.sub_slice_mm > 0.0) || !std::isfinite(params.sub_slice_mm)) {
     return std::unexpected(Error{ErrorCode::invalid_argument, fmt::format("sub-slice spacing must be > 0 mm (got {})", params.sub_slice_mm)});
@@ -551,8 +551,8 @@ std::expected<BevelPlan, Error> detail::plan_bevels_on(const Mesh& mesh, const T
   BevelPlan plan;
   plan.fit = params.fit;
   plan.layers.resize(layers.size());
-  std::optional<detail::TriangleTree> own_tree;
-  const detail::TriangleTree* model = model_tree;
+  std::optional<geometry_detail::TriangleTree> own_tree;
+  const geometry_detail::TriangleTree* model = model_tree;
   if (params.measure_surface_distance && !layers.empty() && !model) {
     own_tree.emplace(mesh.vertices, mesh.faces, params.parallel);
     model = &*own_tree;
@@ -571,7 +571,7 @@ std::expected<BevelPlan, Error> detail::plan_bevels_on(const Mesh& mesh, const T
     // What the tolerance checks is the 3-D distance (issue 17, item 4): a station's plane can
     // neither see a corner that slides along the outline nor the true (normal) distance to a
     // sloped surface.
-    layer.surface_distance_mm = detail::layer_surface_distance(*model, model_z_lo, model_z_hi, layer, subs, params.distance_sample_mm);
+    layer.surface_distance_mm = bevel_detail::layer_surface_distance(*model, model_z_lo, model_z_hi, layer, subs, params.distance_sample_mm);
     layer.max_deviation_mm = layer.surface_distance_mm;
     layer.within_tolerance = layer.max_deviation_mm <= params.tolerance_mm;
   };

@@ -1,14 +1,22 @@
 #include "bevel/bevel_distance.hpp"
 
 #include "geometry/clipper_bridge.hpp"
-#include "geometry/stack_geometry.hpp"
+#include "deviation/surface_distance.hpp"
 
 #include "lamina/core/deviation.hpp"
 
 #include <algorithm>
 #include <cmath>
 
-namespace lamina::detail {
+namespace lamina::bevel_detail {
+using geometry_detail::build_stack_shells;
+using geometry_detail::StackShells;
+using geometry_detail::TriangleTree;
+using deviation_detail::max_distance;
+using deviation_detail::sample_region;
+using geometry_detail::sort_morton;
+using geometry_detail::to_clipper;
+using deviation_detail::wall_samples;
 namespace {
 
 // The model's contours on the sub-slices: every vertex (sharp corners are vertices) and points
@@ -80,4 +88,4 @@ double layer_surface_distance(const TriangleTree& model, double model_z_lo_mm, d
   return std::max(stack_to_model, model_to_stack);
 }
 
-}  // namespace lamina::detail
+}  // namespace lamina::bevel_detail

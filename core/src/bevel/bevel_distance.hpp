@@ -1,7 +1,7 @@
 #pragma once
 // Private: the largest 3-D distance between one layer's cut edge and the model's surface in the
 // layer's height (issue 17, item 4), what the tolerance checks.
-#include "deviation/closest_point.hpp"
+#include "geometry/closest_point.hpp"
 #include "lamina/core/bevel.hpp"
 #include "lamina/core/slice.hpp"
 
@@ -9,7 +9,8 @@
 #include <span>
 #include <vector>
 
-namespace lamina::detail {
+namespace lamina::bevel_detail {
+using geometry_detail::TriangleTree;
 
 // plan_bevels with the model's triangle tree built by the caller (nullptr: built here when
 // params.measure_surface_distance), for callers that plan many times over one mesh (layering).
@@ -27,4 +28,4 @@ std::expected<BevelPlan, Error> plan_bevels_on(const Mesh& mesh, const TriangleT
 double layer_surface_distance(const TriangleTree& model, double model_z_lo_mm, double model_z_hi_mm,
                               const LayerPlan& layer, const std::vector<const Slice*>& sub_slices, double ds_mm);
 
-}  // namespace lamina::detail
+}  // namespace lamina::bevel_detail

@@ -10,7 +10,13 @@
 #include <cmath>
 #include <limits>
 
-namespace lamina::detail {
+namespace lamina::bevel_detail {
+using geometry_detail::edge_ring;
+using geometry_detail::from_clipper;
+using geometry_detail::kClipperUnitsPerMm;
+using geometry_detail::layer_t;
+using geometry_detail::outline_usable;
+using geometry_detail::to_clipper;
 namespace {
 
 // Moving a station changes its neighbours' chords too: a few rounds settle every corner.
@@ -204,4 +210,4 @@ GougeClearance clear_gouges(LayerPlan& layer, const std::vector<const Slice*>& s
   return r;
 }
 
-}  // namespace lamina::detail
+}  // namespace lamina::bevel_detail

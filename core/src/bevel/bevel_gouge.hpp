@@ -11,7 +11,7 @@
 
 #include <vector>
 
-namespace lamina::detail {
+namespace lamina::bevel_detail {
 
 struct GougeClearance {
   double worst_found_mm = 0.0;  // deepest sub-slice material outside the cuts before clearing
@@ -30,4 +30,4 @@ GougeClearance clear_gouges(LayerPlan& layer, const std::vector<const Slice*>& s
 // mesh is float).
 inline constexpr double kGougeTolerance = 1e-4;
 
-}  // namespace lamina::detail
+}  // namespace lamina::bevel_detail

@@ -30,7 +30,7 @@ const ChoiceTable<NestMethod>& nest_methods() {
 const char* nest_method_name(NestMethod method) { return nest_methods().name_of(method); }
 
 Eigen::Vector2d place_point(const Placement& placement, const Eigen::Vector2d& layer_xy) {
-  return detail::rotation_matrix(placement.rotation_rad) * layer_xy + placement.offset_mm;
+  return cam_detail::rotation_matrix(placement.rotation_rad) * layer_xy + placement.offset_mm;
 }
 
 Polygon2 placed_footprint(const Part& part, const Placement& placement) {
@@ -40,7 +40,7 @@ Polygon2 placed_footprint(const Part& part, const Placement& placement) {
   return out;
 }
 
-namespace detail {
+namespace cam_detail {
 
 Eigen::Matrix2d rotation_matrix(double angle_rad) {
   double c = std::cos(angle_rad);
@@ -130,17 +130,17 @@ std::optional<Error> check_params(std::span<const Part> parts, const NestParams&
   return std::nullopt;
 }
 
-std::vector<detail::PackedSheet> pack(std::span<const Part> parts, std::span<const int> which, detail::SheetSize size,
+std::vector<cam_detail::PackedSheet> pack(std::span<const Part> parts, std::span<const int> which, cam_detail::SheetSize size,
                                       const NestParams& params, std::vector<int>& unplaced) {
   if (which.empty()) return {};
-  if (params.method == NestMethod::shape) return detail::pack_shape(parts, which, size, params, unplaced);
-  return detail::pack_matrix(parts, which, size, params, unplaced);
+  if (params.method == NestMethod::shape) return cam_detail::pack_shape(parts, which, size, params, unplaced);
+  return cam_detail::pack_matrix(parts, which, size, params, unplaced);
 }
 
 // How many layers of a group lost no part: `unplaced` are packed parts left over, and the parts
 // in their holes go with them.
 SheetShortage count_placed_layers(std::span<const Part> parts, std::span<const int> group, std::span<const int> unplaced,
-                                  const std::unordered_map<int, std::vector<const detail::HostedPart*>>& children) {
+                                  const std::unordered_map<int, std::vector<const cam_detail::HostedPart*>>& children) {
   std::set<int> layers, lost;
   for (int p : group) layers.insert(parts[p].layer_slot);
   std::vector<int> todo(unplaced.begin(), unplaced.end());
@@ -149,7 +149,7 @@ SheetShortage count_placed_layers(std::span<const Part> parts, std::span<const i
     todo.pop_back();
     lost.insert(parts[p].layer_slot);
     if (auto it = children.find(p); it != children.end())
-      for (const detail::HostedPart* h : it->second) todo.push_back(h->in_host.part);
+      for (const cam_detail::HostedPart* h : it->second) todo.push_back(h->in_host.part);
   }
   SheetShortage s;
   s.layers = static_cast<int>(layers.size());
@@ -159,7 +159,7 @@ SheetShortage count_placed_layers(std::span<const Part> parts, std::span<const i
 
 std::unexpected<Error> nest_error(std::string m) { return std::unexpected(Error{ErrorCode::invalid_argument, std::move(m)}); }
 
-detail::SheetSize size_of(const SheetStock& s) { return detail::SheetSize{s.length_mm, s.width_mm}; }
+cam_detail::SheetSize size_of(const SheetStock& s) { return cam_detail::SheetSize{s.length_mm, s.width_mm}; }
 
 // The stock entries of this thickness, checked: known sizes, counts, and every part fits one.
 std::expected<std::vector<int>, Error> thickness_entries(std::span<const Part> parts, std::span<const int> group,
@@ -181,10 +181,10 @@ std::expected<std::vector<int>, Error> thickness_entries(std::span<const Part> p
   }
   for (int p : group) {
     const bool fits = std::any_of(entries.begin(), entries.end(), [&](int e) {
-      return detail::fits_on_sheet(parts[p], size_of(stock.sheets[e]), params);
+      return cam_detail::fits_on_sheet(parts[p], size_of(stock.sheets[e]), params);
     });
     if (fits) continue;
-    const detail::Bounds b = detail::rotated_bounds(parts[p].footprint_mm, 0.0);
+    const cam_detail::Bounds b = cam_detail::rotated_bounds(parts[p].footprint_mm, 0.0);
     std::string sizes;
     for (int e : entries) sizes += (sizes.empty() ? "" : ", ") + sheet_size_text(stock.sheets[e]);
     return nest_error(fmt::format("nest: part {} ({:.1f} x {:.1f} mm) is larger than every {:g} mm sheet ({}) less the "
@@ -196,18 +196,18 @@ std::expected<std::vector<int>, Error> thickness_entries(std::span<const Part> p
 
 // Children in holes travel with their hosts: only the rest is packed.
 struct HostedTree {
-  std::unordered_map<int, std::vector<const detail::HostedPart*>> children;
+  std::unordered_map<int, std::vector<const cam_detail::HostedPart*>> children;
 
-  explicit HostedTree(const detail::HoleFilling& filling) {
-    for (const detail::HostedPart& h : filling.hosted) children[h.host].push_back(&h);
+  explicit HostedTree(const cam_detail::HoleFilling& filling) {
+    for (const cam_detail::HostedPart& h : filling.hosted) children[h.host].push_back(&h);
   }
   // A packed placement with its children (composed, recursively) before it; each child's `host`
   // is the index of the placement whose hole holds it.
   void emit(const Placement& pl, std::vector<Placement>& list) const {
     std::vector<std::size_t> direct;
     if (auto it = children.find(pl.part); it != children.end())
-      for (const detail::HostedPart* h : it->second) {
-        emit(detail::compose(pl, h->in_host), list);
+      for (const cam_detail::HostedPart* h : it->second) {
+        emit(cam_detail::compose(pl, h->in_host), list);
         direct.push_back(list.size() - 1);
       }
     list.push_back(pl);
@@ -217,12 +217,12 @@ struct HostedTree {
   int carried(int part) const {
     int n = 1;
     if (auto it = children.find(part); it != children.end())
-      for (const detail::HostedPart* h : it->second) n += carried(h->in_host.part);
+      for (const cam_detail::HostedPart* h : it->second) n += carried(h->in_host.part);
     return n;
   }
 };
 
-NestedSheet nested_sheet(std::span<const Part> parts, const detail::PackedSheet& packed, int entry,
+NestedSheet nested_sheet(std::span<const Part> parts, const cam_detail::PackedSheet& packed, int entry,
                          const SheetStock& s, const HostedTree& tree) {
   NestedSheet ns;
   ns.stock_index = entry;
@@ -255,9 +255,9 @@ ThicknessFill fill_entries(std::span<const Part> parts, const std::vector<int>& 
     const SheetStock& s = stock.sheets[e];
     f.in_stock += s.count;
     std::vector<int> here, later;
-    for (int p : remaining) (detail::fits_on_sheet(parts[p], size_of(s), params) ? here : later).push_back(p);
+    for (int p : remaining) (cam_detail::fits_on_sheet(parts[p], size_of(s), params) ? here : later).push_back(p);
     std::vector<int> unplaced;
-    std::vector<detail::PackedSheet> sheets = pack(parts, here, size_of(s), params, unplaced);
+    std::vector<cam_detail::PackedSheet> sheets = pack(parts, here, size_of(s), params, unplaced);
     later.insert(later.end(), unplaced.begin(), unplaced.end());
     const std::size_t take = s.count == 0 ? sheets.size() : std::min<std::size_t>(s.count, sheets.size());
     for (std::size_t i = 0; i < sheets.size(); ++i) {
@@ -303,9 +303,9 @@ std::expected<std::vector<NestedSheet>, Error> nest_thickness(std::span<const Pa
                                                               const NestParams& params, SheetShortage& shortage) {
   auto entries = thickness_entries(parts, group, thickness, stock, params);
   if (!entries) return std::unexpected(entries.error());
-  detail::HoleFilling filling;
+  cam_detail::HoleFilling filling;
   if (params.fill_holes)
-    filling = detail::fill_holes(parts, group, params);
+    filling = cam_detail::fill_holes(parts, group, params);
   else
     filling.free.assign(group.begin(), group.end());
   const HostedTree tree(filling);

@@ -8,7 +8,9 @@
 #include <limits>
 #include <numbers>
 
-namespace lamina::detail {
+namespace lamina::cam_detail {
+using geometry_detail::area_mm2;
+using geometry_detail::kClipperUnitsPerMm;
 
 using ClipperLib::IntPoint;
 using ClipperLib::Path;
@@ -368,4 +370,4 @@ Paths inner_fit(const Paths& room, const Path& c) {
   return {out};
 }
 
-}  // namespace lamina::detail
+}  // namespace lamina::cam_detail

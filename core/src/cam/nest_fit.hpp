@@ -5,7 +5,7 @@
 // non-zero rule (outer rings CCW, holes CW), as Clipper returns them.
 #include "geometry/clipper_bridge.hpp"
 
-namespace lamina::detail {
+namespace lamina::cam_detail {
 
 // Andrew's monotone chain; counter-clockwise (y up), no repeated point, collinear points dropped.
 ClipperLib::Path convex_hull(ClipperLib::Path pts);
@@ -65,4 +65,4 @@ ClipperLib::Paths boolean(ClipperLib::ClipType op, const ClipperLib::Paths& subj
 // negative delta, a subset of the true erosion.
 ClipperLib::Paths offset_mitre(const ClipperLib::Paths& paths, double delta_mm);
 
-}  // namespace lamina::detail
+}  // namespace lamina::cam_detail

@@ -20,7 +20,10 @@
 #include <numbers>
 #include <optional>
 
-namespace lamina::detail {
+namespace lamina::cam_detail {
+using geometry_detail::area_mm2;
+using geometry_detail::kClipperUnitsPerMm;
+using geometry_detail::to_clipper;
 
 namespace {
 
@@ -199,4 +202,4 @@ Placement compose(const Placement& host, const Placement& child) {
   return out;
 }
 
-}  // namespace lamina::detail
+}  // namespace lamina::cam_detail

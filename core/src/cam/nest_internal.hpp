@@ -9,7 +9,7 @@
 #include <span>
 #include <vector>
 
-namespace lamina::detail {
+namespace lamina::cam_detail {
 
 struct SheetSize {
   double length_mm = 0.0;  // x
@@ -80,4 +80,4 @@ HoleFilling fill_holes(std::span<const Part> parts, std::span<const int> group, 
 // R_h·(R_c·p + t_c) + t_h, i.e. rotation_h + rotation_c (in [0, 2π)) and offset R_h·t_c + t_h.
 Placement compose(const Placement& host, const Placement& child_in_host);
 
-}  // namespace lamina::detail
+}  // namespace lamina::cam_detail

@@ -5,7 +5,7 @@
 #include <algorithm>
 #include <numbers>
 
-namespace lamina::detail {
+namespace lamina::cam_detail {
 
 namespace {
 
@@ -120,4 +120,4 @@ std::vector<PackedSheet> pack_matrix(std::span<const Part> parts, std::span<cons
   return out;
 }
 
-}  // namespace lamina::detail
+}  // namespace lamina::cam_detail

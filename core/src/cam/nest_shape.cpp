@@ -33,7 +33,9 @@ inline bool operator!=(const Radians& a, const Radians& b) { return !(a == b); }
 #include <Eigen/Core>
 #include <cmath>
 
-namespace lamina::detail {
+namespace lamina::cam_detail {
+using geometry_detail::kClipperUnitsPerMm;
+using geometry_detail::to_clipper;
 
 namespace {
 
@@ -193,4 +195,4 @@ std::vector<PackedSheet> pack_shape(std::span<const Part> parts, std::span<const
   return out;
 }
 
-}  // namespace lamina::detail
+}  // namespace lamina::cam_detail

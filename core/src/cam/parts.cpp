@@ -24,8 +24,8 @@ ClipperLib::Paths pass_rings(const LayerOutline& outline) {
       top.emplace_back(l.top_mm.x(), l.top_mm.y());
       bottom.emplace_back(l.bottom_mm.x(), l.bottom_mm.y());
     }
-    rings.push_back(detail::to_clipper(top));
-    rings.push_back(detail::to_clipper(bottom));
+    rings.push_back(geometry_detail::to_clipper(top));
+    rings.push_back(geometry_detail::to_clipper(bottom));
   }
   return rings;
 }
@@ -44,10 +44,10 @@ ClipperLib::Paths boolean(ClipperLib::ClipType op, const ClipperLib::Paths& a, c
 ClipperLib::Paths offset(const ClipperLib::Paths& paths, double delta_mm) {
   if (delta_mm == 0.0) return paths;
   ClipperLib::ClipperOffset o;
-  o.ArcTolerance = 0.005 * detail::kClipperUnitsPerMm;  // 5 µm: round joins stay few points
+  o.ArcTolerance = 0.005 * geometry_detail::kClipperUnitsPerMm;  // 5 µm: round joins stay few points
   o.AddPaths(paths, ClipperLib::jtRound, ClipperLib::etClosedPolygon);
   ClipperLib::Paths out;
-  o.Execute(out, delta_mm * detail::kClipperUnitsPerMm);
+  o.Execute(out, delta_mm * geometry_detail::kClipperUnitsPerMm);
   return out;
 }
 
@@ -77,8 +77,8 @@ ClipperLib::Paths certain_material(const LayerPlan& layer) {
 }
 
 bool inside(const ClipperLib::Paths& region, const Eigen::Vector2d& p) {
-  const ClipperLib::IntPoint q(static_cast<ClipperLib::cInt>(std::llround(p.x() * detail::kClipperUnitsPerMm)),
-                               static_cast<ClipperLib::cInt>(std::llround(p.y() * detail::kClipperUnitsPerMm)));
+  const ClipperLib::IntPoint q(static_cast<ClipperLib::cInt>(std::llround(p.x() * geometry_detail::kClipperUnitsPerMm)),
+                               static_cast<ClipperLib::cInt>(std::llround(p.y() * geometry_detail::kClipperUnitsPerMm)));
   int winding = 0;
   for (const ClipperLib::Path& ring : region) {
     const int in = ClipperLib::PointInPolygon(q, ring);
@@ -125,19 +125,19 @@ std::expected<std::vector<Eigen::Vector2d>, Error> place_dowels(const BevelPlan&
   ClipperLib::cInt x0 = std::numeric_limits<ClipperLib::cInt>::max(), y0 = x0, x1 = -x0, y1 = -x0;
   for (const auto& ring : room)
     for (const auto& p : ring) x0 = std::min(x0, p.X), x1 = std::max(x1, p.X), y0 = std::min(y0, p.Y), y1 = std::max(y1, p.Y);
-  const double w = (x1 - x0) / detail::kClipperUnitsPerMm, h = (y1 - y0) / detail::kClipperUnitsPerMm;
+  const double w = (x1 - x0) / geometry_detail::kClipperUnitsPerMm, h = (y1 - y0) / geometry_detail::kClipperUnitsPerMm;
   const double step = std::max({w, h, 1e-3}) / 120.0;
   std::vector<Eigen::Vector2d> candidates;
   Eigen::Vector2d centroid = Eigen::Vector2d::Zero();
-  for (double y = y0 / detail::kClipperUnitsPerMm + 0.5 * step; y < y1 / detail::kClipperUnitsPerMm; y += step)
-    for (double x = x0 / detail::kClipperUnitsPerMm + 0.5 * step; x < x1 / detail::kClipperUnitsPerMm; x += step) {
+  for (double y = y0 / geometry_detail::kClipperUnitsPerMm + 0.5 * step; y < y1 / geometry_detail::kClipperUnitsPerMm; y += step)
+    for (double x = x0 / geometry_detail::kClipperUnitsPerMm + 0.5 * step; x < x1 / geometry_detail::kClipperUnitsPerMm; x += step) {
       const Eigen::Vector2d p(x, y);
       if (inside(room, p)) candidates.push_back(p), centroid += p;
     }
   // A room thinner than the grid: its own vertices are candidates too.
   for (const auto& ring : room)
     for (const auto& p : ring) {
-      const Eigen::Vector2d q(p.X / detail::kClipperUnitsPerMm, p.Y / detail::kClipperUnitsPerMm);
+      const Eigen::Vector2d q(p.X / geometry_detail::kClipperUnitsPerMm, p.Y / geometry_detail::kClipperUnitsPerMm);
       candidates.push_back(q), centroid += q;
     }
   centroid /= static_cast<double>(candidates.size());
@@ -198,7 +198,7 @@ std::expected<std::vector<Part>, Error> make_parts(const BevelPlan& plan, const 
         if (ClipperLib::Orientation(ring) && (!largest || ClipperLib::Area(ring) > ClipperLib::Area(*largest))) largest = &ring;
       if (!largest)
         return std::unexpected(invalid(fmt::format("layer {} outline {}: the cuts enclose no area", layer.index, oi)));
-      part.footprint_mm = detail::from_clipper(*largest);
+      part.footprint_mm = geometry_detail::from_clipper(*largest);
 
       // Free room in each hole: inside every ring of the hole on both faces, less half the kerf.
       for (const int hi : part.holes) {
@@ -210,7 +210,7 @@ std::expected<std::vector<Part>, Error> make_parts(const BevelPlan& plan, const 
           first = false;
         }
         for (const auto& ring : offset(room, -0.5 * params.kerf_mm))
-          if (ClipperLib::Orientation(ring) && ClipperLib::Area(ring) > 0) part.free_holes_mm.push_back(detail::from_clipper(ring));
+          if (ClipperLib::Orientation(ring) && ClipperLib::Area(ring) > 0) part.free_holes_mm.push_back(geometry_detail::from_clipper(ring));
       }
 
       // Material at each face of the freeing pass, holes removed; the larger face counts.

@@ -32,9 +32,9 @@ const char* move_kind_name(MoveKind kind) {
 
 namespace {
 
-using detail::CompensatedPass;
-using detail::PathPoint;
-using detail::SheetFrame;
+using cam_detail::CompensatedPass;
+using cam_detail::PathPoint;
+using cam_detail::SheetFrame;
 
 // Lines of two passes at one station closer than this are the same cut.
 constexpr double kSameLineMm = 1e-6;
@@ -230,9 +230,9 @@ class SheetBuilder {
     for (const CutPass& pass : outline.passes) {
       if (pass.lines.size() != outline.stations.size())
         return std::unexpected(invalid(where + ": passes with different station counts"));
-      passes.push_back(detail::compensate_pass(outline, pass, frame, p_.part_on_right, h));
+      passes.push_back(cam_detail::compensate_pass(outline, pass, frame, p_.part_on_right, h));
       if (auto ok = feed_points(passes.back().points, where); !ok) return ok;
-      detail::mark_corners(passes.back().points, p_.corner_angle_rad, p_.corner_min_fraction);
+      cam_detail::mark_corners(passes.back().points, p_.corner_angle_rad, p_.corner_min_fraction);
     }
     // Microjoints on the outer outline's freeing pass, as station parameters so every pass of the
     // outline leaves them at the same place.
@@ -298,7 +298,7 @@ class SheetBuilder {
     return marked;
   }
 
-  // The station parameter (see detail::arc_at) at arc length s of a pass.
+  // The station parameter (see cam_detail::arc_at) at arc length s of a pass.
   static double station_param(const CompensatedPass& pass, double s) {
     const std::size_t n = pass.points.size();
     for (std::size_t i = 0; i < n; ++i) {
@@ -319,7 +319,7 @@ class SheetBuilder {
           "sheet {}, part {}: {} microjoint(s) of {} mm (kerf included) do not fit an outline {:.3f} mm long",
           sheet_.index, part_label(parts_[static_cast<std::size_t>(t.part)]), gaps_u.size(), gap_mm, pass.length_mm)));
     std::vector<double> centres;
-    for (double u : gaps_u) centres.push_back(detail::arc_at(pass, u));
+    for (double u : gaps_u) centres.push_back(cam_detail::arc_at(pass, u));
     std::sort(centres.begin(), centres.end());
     const std::size_t k = centres.size();
     for (std::size_t j = 0; j < k; ++j) {
@@ -327,11 +327,11 @@ class SheetBuilder {
       double s1 = centres[(j + 1) % k] - 0.5 * gap_mm;
       if (j + 1 == k) s1 += pass.length_mm;
       if (s1 - s0 < 1e-6) continue;
-      emit_contour(detail::sub_path(pass, s0, s1), pass.points, t, frees, false);
+      emit_contour(cam_detail::sub_path(pass, s0, s1), pass.points, t, frees, false);
       if (frees) {
         // The uncut material: the gap minus the kerf on both sides.
         const double a = s1 + 0.5 * p_.kerf_mm, b = s1 + gap_mm - 0.5 * p_.kerf_mm;
-        const auto piece = detail::sub_path(pass, a, b);
+        const auto piece = cam_detail::sub_path(pass, a, b);
         out_.microjoints.push_back({t.placement, piece.front().tip.head<2>(), piece.back().tip.head<2>()});
       }
     }
@@ -356,7 +356,7 @@ class SheetBuilder {
       ring.push_back(q);
     }
     if (auto ok = feed_points(ring, fmt::format("sheet {}, dowel hole", sheet_.index)); !ok) return ok;
-    detail::mark_corners(ring, p_.corner_angle_rad, p_.corner_min_fraction);
+    cam_detail::mark_corners(ring, p_.corner_angle_rad, p_.corner_min_fraction);
     std::vector<PathPoint> closed = ring;
     closed.push_back(closed.front());
     t.outline = -1;
@@ -370,7 +370,7 @@ class SheetBuilder {
   // contour's own ring (small holes: the pierce lands near the middle).
   static double fit_lead(double wanted, const std::vector<PathPoint>& ring, const Eigen::Vector2d& p,
                          const Eigen::Vector2d& dir) {
-    return std::min(wanted, 0.5 * detail::ray_to_ring(ring, p, dir));
+    return std::min(wanted, 0.5 * cam_detail::ray_to_ring(ring, p, dir));
   }
 
   void push(MoveKind kind, const Eigen::Vector3d& tip, const Eigen::Vector3d& axis, double feed, double duration,

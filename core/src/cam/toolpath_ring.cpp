@@ -5,7 +5,7 @@
 #include <cmath>
 #include <limits>
 
-namespace lamina::detail {
+namespace lamina::cam_detail {
 namespace {
 
 // A mitre longer than this many half-kerfs is cut short: needle-sharp spikes of an outline would
@@ -169,4 +169,4 @@ double ray_to_ring(const std::vector<PathPoint>& ring, const Eigen::Vector2d& fr
   return best;
 }
 
-}  // namespace lamina::detail
+}  // namespace lamina::cam_detail

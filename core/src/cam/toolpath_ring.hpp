@@ -8,7 +8,7 @@
 
 #include <vector>
 
-namespace lamina::detail {
+namespace lamina::cam_detail {
 
 // Layer (build frame) → sheet frame: rotate about +Z, shift, and put the layer's top face at z = 0.
 struct SheetFrame {
@@ -66,4 +66,4 @@ std::vector<PathPoint> sub_path(const CompensatedPass& pass, double s0_mm, doubl
 // tip points (ignoring crossings closer than 1 µm); infinity when there is none.
 double ray_to_ring(const std::vector<PathPoint>& ring, const Eigen::Vector2d& from, const Eigen::Vector2d& dir);
 
-}  // namespace lamina::detail
+}  // namespace lamina::cam_detail

@@ -10,7 +10,7 @@
 
 #include "geometry/clipper_bridge.hpp"
 #include "lamina/core/slice.hpp"
-#include "geometry/stack_geometry.hpp"
+#include "deviation/surface_distance.hpp"
 
 #include <Eigen/Geometry>
 #include <fmt/format.h>
@@ -56,7 +56,7 @@ std::expected<void, Error> check_plan(const BevelPlan& plan) {
                              l, layer.z_bottom_mm, layer.thickness_mm));
     for (std::size_t o = 0; o < layer.outlines.size(); ++o) {
       const LayerOutline& outline = layer.outlines[o];
-      if (!detail::outline_usable(outline))
+      if (!geometry_detail::outline_usable(outline))
         return bad(fmt::format("measure_deviation: layer {} outline {} is not usable ({} stations, {} passes; need "
                                ">= 3 stations, one line per station in every pass, finite points)",
                                l, o, outline.stations.size(), outline.passes.size()));
@@ -93,12 +93,12 @@ struct SectionAreas {
 // of slivers and sorts out their nesting in quadratic time; the intersection is one clean polygon.
 SectionAreas section_areas(const Slice& slice, const BevelPlan& plan, double z) {
   ClipperLib::Paths model;
-  for (const auto& loop : slice.loops) model.push_back(detail::to_clipper(loop.points));
+  for (const auto& loop : slice.loops) model.push_back(geometry_detail::to_clipper(loop.points));
   ClipperLib::Paths stack;
   int layers_here = 0;
   for (const auto& layer : plan.layers) {
     if (!(z >= layer.z_bottom_mm && z <= layer.z_top_mm())) continue;
-    const auto section = detail::to_clipper(layer_section(layer, z));
+    const auto section = geometry_detail::to_clipper(layer_section(layer, z));
     stack.insert(stack.end(), section.begin(), section.end());
     ++layers_here;
   }
@@ -108,12 +108,12 @@ SectionAreas section_areas(const Slice& slice, const BevelPlan& plan, double z) 
     u.Execute(ClipperLib::ctUnion, stack, ClipperLib::pftPositive, ClipperLib::pftPositive);
   }
   SectionAreas r;
-  r.stack_mm2 = detail::area_mm2(stack);
+  r.stack_mm2 = geometry_detail::area_mm2(stack);
   ClipperLib::Clipper c;
   c.AddPaths(model, ClipperLib::ptSubject, true);
   ClipperLib::Paths model_clean;
   c.Execute(ClipperLib::ctUnion, model_clean, ClipperLib::pftPositive, ClipperLib::pftPositive);
-  const double model_area = detail::area_mm2(model_clean);
+  const double model_area = geometry_detail::area_mm2(model_clean);
   double common = 0.0;
   if (!model_clean.empty() && !stack.empty()) {
     c.Clear();
@@ -121,7 +121,7 @@ SectionAreas section_areas(const Slice& slice, const BevelPlan& plan, double z) 
     c.AddPaths(stack, ClipperLib::ptClip, true);
     ClipperLib::Paths both;
     c.Execute(ClipperLib::ctIntersection, both, ClipperLib::pftPositive, ClipperLib::pftPositive);
-    common = detail::area_mm2(both);
+    common = geometry_detail::area_mm2(both);
   }
   r.xor_mm2 = std::max(0.0, model_area + r.stack_mm2 - 2.0 * common);
   return r;
@@ -216,7 +216,7 @@ std::expected<Deviation, Error> measure_deviation(const Mesh& mesh, const BevelP
   }
   d.model_volume_mm3 = mesh_volume(mesh);
   d.volume_pct = d.model_volume_mm3 > 0.0 ? 100.0 * d.volume_mm3 / d.model_volume_mm3 : 0.0;
-  const detail::FarthestPoint far = detail::max_surface_distance(mesh, plan, params);
+  const deviation_detail::FarthestPoint far = deviation_detail::max_surface_distance(mesh, plan, params);
   d.max_mm = far.distance;
   d.max_at_mm = far.at;
   return d;

@@ -6,8 +6,8 @@
 // end on their first triangle: the one nearest to the previous sample. The result is exact for
 // the samples whatever the threads: only queries that cannot matter are cut short.
 #include "geometry/clipper_bridge.hpp"
-#include "deviation/closest_point.hpp"
-#include "geometry/stack_geometry.hpp"
+#include "geometry/closest_point.hpp"
+#include "deviation/surface_distance.hpp"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -16,7 +16,22 @@
 #include <atomic>
 #include <cmath>
 
-namespace lamina::detail {
+namespace lamina::deviation_detail {
+using geometry_detail::area_mm2;
+using geometry_detail::base_ring;
+using geometry_detail::build_stack_shells;
+using geometry_detail::edge_ring;
+using geometry_detail::envelope_kinks;
+using geometry_detail::from_clipper;
+using geometry_detail::kClipperUnitsPerMm;
+using geometry_detail::OffsetLine;
+using geometry_detail::outline_usable;
+using geometry_detail::reversed_share;
+using geometry_detail::sort_morton;
+using geometry_detail::StackShells;
+using geometry_detail::station_lines;
+using geometry_detail::station_offset;
+using geometry_detail::to_clipper;
 
 // Samples of a horizontal region (Clipper paths, positive fill) at height z: its vertices, its
 // edges every `spacing` and the points of a `spacing` grid inside it (coarser when the region is
@@ -274,4 +289,4 @@ FarthestPoint max_surface_distance(const Mesh& mesh, const BevelPlan& plan, cons
   return model_to_stack.distance > stack_to_model.distance ? model_to_stack : stack_to_model;
 }
 
-}  // namespace lamina::detail
+}  // namespace lamina::deviation_detail

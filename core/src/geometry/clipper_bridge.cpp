@@ -17,7 +17,7 @@ double signed_area_mm2(const Polygon2& ring) {
 
 }  // namespace lamina
 
-namespace lamina::detail {
+namespace lamina::geometry_detail {
 
 ClipperLib::Path to_clipper(const Polygon2& ring) {
   ClipperLib::Path path;
@@ -58,4 +58,4 @@ double area_mm2(const ClipperLib::Paths& paths) {
   return sum / (kClipperUnitsPerMm * kClipperUnitsPerMm);
 }
 
-}  // namespace lamina::detail
+}  // namespace lamina::geometry_detail

@@ -7,7 +7,7 @@
 
 #include <vector>
 
-namespace lamina::detail {
+namespace lamina::geometry_detail {
 
 inline constexpr double kClipperUnitsPerMm = 1e6;
 
@@ -19,4 +19,4 @@ std::vector<Polygon2> from_clipper(const ClipperLib::Paths& paths);
 // Net signed area of paths in mm² (holes count negative).
 double area_mm2(const ClipperLib::Paths& paths);
 
-}  // namespace lamina::detail
+}  // namespace lamina::geometry_detail

@@ -15,7 +15,7 @@
 #include <limits>
 #include <unordered_map>
 
-namespace lamina::detail {
+namespace lamina::geometry_detail {
 namespace {
 
 void fan(std::uint32_t n, std::vector<std::array<std::uint32_t, 3>>& out) {
@@ -296,4 +296,4 @@ bool triangulate_polygon(std::span<const Eigen::Vector3f> corners, std::vector<s
   return within_budget;
 }
 
-}  // namespace lamina::detail
+}  // namespace lamina::geometry_detail

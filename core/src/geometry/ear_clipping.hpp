@@ -8,7 +8,7 @@
 #include <span>
 #include <vector>
 
-namespace lamina::detail {
+namespace lamina::geometry_detail {
 
 // Reusable buffers so that a reader triangulating many polygons does not allocate per polygon.
 struct EarClippingScratch {
@@ -30,4 +30,4 @@ struct EarClippingScratch {
 bool triangulate_polygon(std::span<const Eigen::Vector3f> corners, std::vector<std::array<std::uint32_t, 3>>& out,
                          EarClippingScratch& scratch);
 
-}  // namespace lamina::detail
+}  // namespace lamina::geometry_detail

@@ -18,7 +18,7 @@
 #include <limits>
 #include <numeric>
 
-namespace lamina::detail {
+namespace lamina::geometry_detail {
 namespace {
 
 // Polygons from this many vertices on get trees for their ear tests.
@@ -597,4 +597,4 @@ std::vector<std::array<std::int32_t, 3>> triangulate_polygon_with_holes(const Po
   return std::move(tri.out);
 }
 
-}  // namespace lamina::detail
+}  // namespace lamina::geometry_detail

@@ -7,7 +7,7 @@
 #include <cstdint>
 #include <vector>
 
-namespace lamina::detail {
+namespace lamina::geometry_detail {
 
 // A corner turning with a smaller sine than this counts as straight when looking for ears:
 // cutting it would leave a sliver that rounding to float (STL) can flatten to zero area.
@@ -40,4 +40,4 @@ std::vector<std::array<std::int32_t, 3>> triangulate_polygon_with_holes(const Po
                                                                         double straight_sine = kCapStraightSine,
                                                                         TriangulationWork* work = nullptr);
 
-}  // namespace lamina::detail
+}  // namespace lamina::geometry_detail

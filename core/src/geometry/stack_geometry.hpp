@@ -15,7 +15,7 @@
 #include <cstdint>
 #include <vector>
 
-namespace lamina::detail {
+namespace lamina::geometry_detail {
 
 // One station's pass lines as offsets along its normal: u(t) = bottom + t · (top − bottom),
 // t = 0 at the layer's bottom face and 1 at its top face.
@@ -69,30 +69,4 @@ struct StackShells {
 };
 StackShells build_stack_shells(const BevelPlan& plan);
 
-// The largest distance between the stack's surface and the model's (both ways), estimated on
-// samples: the stack's walls (stations at heights no further apart than
-// params.distance_sample_mm, where the envelope of their lines kinks, and along the outline
-// between stations) and its exposed faces (each layer's top and bottom where the neighbouring
-// layer does not cover it) against the model's triangles; the model's vertices and facet
-// centroids against the stack shells. Needs a plan that passed measure_deviation's checks.
-struct FarthestPoint {
-  double distance = 0.0;
-  Eigen::Vector3d at = Eigen::Vector3d::Zero();
-};
-FarthestPoint max_surface_distance(const Mesh& mesh, const BevelPlan& plan, const DeviationParams& params);
-
-// Points on a layer's side walls (the edge its cuts leave): rows no more than ds apart from face
-// to face, where the envelope of a station's lines kinks, and along the outline between stations.
-void wall_samples(const LayerPlan& layer, double ds, std::vector<Eigen::Vector3d>& out);
-
-// Samples of a horizontal region (Clipper paths, positive fill) at height z: its vertices, its
-// edges every `spacing` and the points of a `spacing` grid inside it (coarser when the grid would
-// exceed `budget` points).
-void sample_region(const ClipperLib::Paths& region, double z, double spacing, double budget,
-                   std::vector<Eigen::Vector3d>& out);
-
-class TriangleTree;
-// The sample farthest from the tree's triangles (the first of equals, in sample order).
-FarthestPoint max_distance(const TriangleTree& tree, const std::vector<Eigen::Vector3d>& samples, bool parallel);
-
-}  // namespace lamina::detail
+}  // namespace lamina::geometry_detail

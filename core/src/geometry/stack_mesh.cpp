@@ -23,7 +23,7 @@
 #include <limits>
 
 namespace lamina {
-namespace detail {
+namespace geometry_detail {
 namespace {
 
 using Rings = std::vector<Polygon2>;  // one group at one height: outer first, then its holes
@@ -461,7 +461,7 @@ StackShells build_stack_shells(const BevelPlan& plan) {
 }  // namespace detail
 
 TriangleSoup stack_mesh(const BevelPlan& plan) {
-  const detail::StackShells shells = detail::build_stack_shells(plan);
+  const geometry_detail::StackShells shells = geometry_detail::build_stack_shells(plan);
   TriangleSoup soup;
   soup.format = "stack";
   soup.corners.reserve(3 * shells.faces.size());

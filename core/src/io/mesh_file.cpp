@@ -96,10 +96,10 @@ std::expected<Bytes, Error> read_whole(InputFile& file, std::span<const std::byt
 // Binary STL, converted chunk by chunk. `chunk` holds the first `have` bytes of the file.
 std::expected<TriangleSoup, Error> stream_binary_stl(InputFile& file, std::byte* chunk, std::size_t have,
                                                      std::uint32_t count, const std::string& name,
-                                                     const detail::FileQuote& quote) {
-  using detail::kStlPreambleBytes;
-  using detail::kStlTriangleBytes;
-  detail::StlBinaryDecoder decoder(count);
+                                                     const io_detail::FileQuote& quote) {
+  using io_detail::kStlPreambleBytes;
+  using io_detail::kStlTriangleBytes;
+  io_detail::StlBinaryDecoder decoder(count);
   std::size_t offset = kStlPreambleBytes;
   for (;;) {
     const std::size_t records = std::min((have - offset) / kStlTriangleBytes, count - decoder.decoded());
@@ -110,7 +110,7 @@ std::expected<TriangleSoup, Error> stream_binary_stl(InputFile& file, std::byte*
     auto got = file.read(chunk + leftover, kChunkBytes - leftover);
     if (!got) return std::unexpected(got.error());
     if (*got == 0) {  // the file shrank after fstat
-      return std::unexpected(detail::stl_short_binary_error(
+      return std::unexpected(io_detail::stl_short_binary_error(
           name, count, kStlPreambleBytes + kStlTriangleBytes * decoder.decoded() + leftover, quote));
     }
     have = leftover + *got;
@@ -121,7 +121,7 @@ std::expected<TriangleSoup, Error> stream_binary_stl(InputFile& file, std::byte*
 
 std::string lower_extension(const std::filesystem::path& path) {
   std::string ext = path.extension().string();
-  for (char& c : ext) c = detail::ascii_lower(c);
+  for (char& c : ext) c = io_detail::ascii_lower(c);
   return ext;
 }
 
@@ -134,7 +134,7 @@ bool looks_like_obj(std::string_view text) {
     std::string_view line = text.substr(pos, eol - pos);
     pos = eol + 1;
     std::size_t i = 0;
-    while (i < line.size() && detail::is_space(line[i])) ++i;
+    while (i < line.size() && io_detail::is_space(line[i])) ++i;
     line.remove_prefix(i);
     if (line.empty() || line.front() == '#') continue;
     for (std::string_view kw : {"v ", "v\t", "vn ", "vt ", "f ", "o ", "g ", "mtllib ", "usemtl ", "s "})
@@ -182,10 +182,10 @@ std::expected<TriangleSoup, Error> read_mesh_file(const std::filesystem::path& p
   auto chunk = std::make_unique_for_overwrite<std::byte[]>(kChunkBytes);
   auto first = file->read(chunk.get(), static_cast<std::size_t>(std::min<std::uint64_t>(file->size(), kChunkBytes)));
   if (!first) return std::unexpected(std::move(first.error()));
-  const detail::StlProbe probe = detail::probe_stl({chunk.get(), *first}, file->size());
+  const io_detail::StlProbe probe = io_detail::probe_stl({chunk.get(), *first}, file->size());
   if (!probe.ascii_like && probe.binary_fits && probe.declared > 0) {
     return stream_binary_stl(*file, chunk.get(), *first, static_cast<std::uint32_t>(probe.declared), name,
-                             detail::FileQuote(options.quote_file_text));
+                             io_detail::FileQuote(options.quote_file_text));
   }
 
   auto all = read_whole(*file, {chunk.get(), *first});

@@ -11,7 +11,7 @@
 #include <string_view>
 #include <system_error>
 
-namespace lamina::detail {
+namespace lamina::io_detail {
 
 constexpr bool is_space(char c) {
   return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\v' || c == '\f';
@@ -125,4 +125,4 @@ class FileQuote {
   bool quote_;
 };
 
-}  // namespace lamina::detail
+}  // namespace lamina::io_detail

@@ -42,9 +42,9 @@ struct Tokens {
   const char* p;
   const char* end;
   std::string_view next() {
-    while (p < end && detail::is_space(*p)) ++p;
+    while (p < end && io_detail::is_space(*p)) ++p;
     const char* b = p;
-    while (p < end && !detail::is_space(*p)) ++p;
+    while (p < end && !io_detail::is_space(*p)) ++p;
     return {b, static_cast<std::size_t>(p - b)};
   }
 };
@@ -63,7 +63,7 @@ bool is_skipped_statement(std::string_view kw) {
 // The parser of one file's statements; every error names the line.
 class ObjParser {
  public:
-  ObjParser(std::string_view text, std::string_view name, const detail::FileQuote& quote)
+  ObjParser(std::string_view text, std::string_view name, const io_detail::FileQuote& quote)
       : text_(text), name_(name), quote_(quote) {
     out_.vertices.reserve(text.size() / 64 + 1);
     out_.indices.reserve(text.size() / 16 + 1);
@@ -111,7 +111,7 @@ class ObjParser {
     for (float& value : c) {
       const std::string_view t = tok.next();
       if (t.empty()) return std::unexpected(parse_error(name_, line_, "vertex with fewer than 3 coordinates"));
-      const char* end = detail::parse_float(t.data(), t.data() + t.size(), value);
+      const char* end = io_detail::parse_float(t.data(), t.data() + t.size(), value);
       if (end != t.data() + t.size()) {
         return std::unexpected(parse_error(
             name_, line_, fmt::format("expected a vertex coordinate, found {}", quote_.text(t, "a token"))));
@@ -127,7 +127,7 @@ class ObjParser {
     for (std::string_view t = tok.next(); !t.empty(); t = tok.next()) {
       std::int64_t index = 0;
       const char* t_end = t.data() + t.size();
-      const char* end = detail::parse_int(t.data(), t_end, index);
+      const char* end = io_detail::parse_int(t.data(), t_end, index);
       bool well_formed = end != nullptr && (end == t_end || *end == '/');
       for (const char* q = end; well_formed && q < t_end; ++q)
         well_formed = (*q >= '0' && *q <= '9') || *q == '/' || *q == '-' || *q == '+';
@@ -160,14 +160,14 @@ class ObjParser {
 
   std::string_view text_;
   std::string_view name_;
-  detail::FileQuote quote_;
+  io_detail::FileQuote quote_;
   ObjStatements out_;
   std::size_t line_ = 0;
 };
 
 // Every face's triangles, corners copied from the vertices; polygons ear-clipped.
 std::expected<TriangleSoup, Error> triangulate_faces(const ObjStatements& in, std::string_view name,
-                                                     const detail::FileQuote& quote, std::size_t& polygons) {
+                                                     const io_detail::FileQuote& quote, std::size_t& polygons) {
   TriangleSoup soup;
   soup.format = "obj";
   std::size_t triangle_total = 0;
@@ -176,7 +176,7 @@ std::expected<TriangleSoup, Error> triangulate_faces(const ObjStatements& in, st
 
   std::vector<Eigen::Vector3f> polygon;
   std::vector<std::array<std::uint32_t, 3>> triangles;
-  detail::EarClippingScratch scratch;
+  geometry_detail::EarClippingScratch scratch;
   for (const Face& f : in.faces) {
     const std::uint32_t* idx = in.indices.data() + f.first;
     for (std::uint32_t k = 0; k < f.size; ++k) {
@@ -194,7 +194,7 @@ std::expected<TriangleSoup, Error> triangulate_faces(const ObjStatements& in, st
     polygon.clear();
     for (std::uint32_t k = 0; k < f.size; ++k) polygon.push_back(in.vertices[idx[k]]);
     triangles.clear();
-    if (!detail::triangulate_polygon(polygon, triangles, scratch)) {
+    if (!geometry_detail::triangulate_polygon(polygon, triangles, scratch)) {
       return std::unexpected(Error{
           ErrorCode::limit_exceeded,
           fmt::format("{}:{}: OBJ: the face of {} corners could not be triangulated within the work bound (it "
@@ -208,13 +208,13 @@ std::expected<TriangleSoup, Error> triangulate_faces(const ObjStatements& in, st
 }
 
 void append_notes(TriangleSoup& soup, const ObjStatements& in, std::size_t polygons, std::string_view name,
-                  const detail::FileQuote& quote) {
+                  const io_detail::FileQuote& quote) {
   if (polygons > 0) {
     soup.notes.push_back({"polygons_triangulated",
                           fmt::format("{}: {} faces with more than 3 vertices were triangulated", name, polygons)});
   }
   if (in.unknown_statements > 0) {
-    const std::string first = quote.either(fmt::format("{} on line {}", detail::quote_excerpt(in.first_unknown),
+    const std::string first = quote.either(fmt::format("{} on line {}", io_detail::quote_excerpt(in.first_unknown),
                                                        in.first_unknown_line),
                                            fmt::format("on line {}", in.first_unknown_line));
     soup.notes.push_back({"unknown_statements", fmt::format("{}: {} unrecognised statements ignored (first: {})", name,
@@ -231,7 +231,7 @@ void append_notes(TriangleSoup& soup, const ObjStatements& in, std::size_t polyg
 
 std::expected<TriangleSoup, Error> parse_obj(std::string_view text, std::string_view name,
                                              const MeshReadOptions& options) {
-  const detail::FileQuote quote(options.quote_file_text);
+  const io_detail::FileQuote quote(options.quote_file_text);
   auto statements = ObjParser(text, name, quote).parse();
   if (!statements) return std::unexpected(std::move(statements.error()));
   if (statements->faces.empty()) {

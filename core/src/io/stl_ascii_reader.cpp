@@ -10,7 +10,7 @@
 #include <cmath>
 #include <string>
 
-namespace lamina::detail {
+namespace lamina::io_detail {
 namespace {
 
 class Scanner {
@@ -219,4 +219,4 @@ std::expected<TriangleSoup, Error> parse_stl_ascii(std::string_view text, std::s
   return soup;
 }
 
-}  // namespace lamina::detail
+}  // namespace lamina::io_detail

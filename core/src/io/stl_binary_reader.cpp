@@ -10,7 +10,7 @@
 #include <cstdint>
 #include <cstring>
 
-namespace lamina::detail {
+namespace lamina::io_detail {
 namespace {
 
 // Twelve little-endian float32 starting at p (any alignment, any host byte order).
@@ -87,4 +87,4 @@ std::expected<TriangleSoup, Error> parse_stl_binary(std::span<const std::byte> b
   return std::move(decoder).finish(name, bytes.size(), quote);
 }
 
-}  // namespace lamina::detail
+}  // namespace lamina::io_detail

@@ -14,7 +14,7 @@
 #include <string_view>
 #include <vector>
 
-namespace lamina::detail {
+namespace lamina::io_detail {
 
 // Stored facet normals are not used for geometry, but they say something about the exporter.
 struct StlNormalStats {
@@ -104,4 +104,4 @@ std::expected<TriangleSoup, Error> parse_stl_binary(std::span<const std::byte> b
 std::expected<TriangleSoup, Error> parse_stl_ascii(std::string_view text, std::string_view name,
                                                    const FileQuote& quote);
 
-}  // namespace lamina::detail
+}  // namespace lamina::io_detail

@@ -28,10 +28,10 @@ std::uint32_t read_u32_le(const std::byte* p) {
 // True when the first bytes contain no control character other than whitespace (bytes ≥ 0x80 are
 // allowed: names may be UTF-8). Binary STL data almost always has 0x00 bytes within them.
 bool prefix_is_text(std::string_view text) {
-  const std::size_t n = std::min(text.size(), detail::kStlTextProbeBytes);
+  const std::size_t n = std::min(text.size(), io_detail::kStlTextProbeBytes);
   for (std::size_t i = 0; i < n; ++i) {
     auto c = static_cast<unsigned char>(text[i]);
-    if (c < 0x20 && !detail::is_space(static_cast<char>(c))) return false;
+    if (c < 0x20 && !io_detail::is_space(static_cast<char>(c))) return false;
     if (c == 0x7f) return false;
   }
   return true;
@@ -40,18 +40,18 @@ bool prefix_is_text(std::string_view text) {
 std::string_view skip_bom_and_space(std::string_view text) {
   if (text.starts_with("\xEF\xBB\xBF")) text.remove_prefix(3);
   std::size_t i = 0;
-  while (i < text.size() && detail::is_space(text[i])) ++i;
+  while (i < text.size() && io_detail::is_space(text[i])) ++i;
   return text.substr(i);
 }
 
 bool starts_with_solid_keyword(std::string_view text) {
   std::string_view t = skip_bom_and_space(text);
-  return detail::istarts_with(t, "solid") && (t.size() == 5 || detail::is_space(t[5]));
+  return io_detail::istarts_with(t, "solid") && (t.size() == 5 || io_detail::is_space(t[5]));
 }
 
 }  // namespace
 
-namespace detail {
+namespace io_detail {
 
 void StlNormalStats::append_notes(std::vector<ReadNote>& notes, std::string_view name,
                                   const FileQuote& quote) const {
@@ -119,34 +119,34 @@ void append_non_finite_note(std::vector<ReadNote>& notes, std::string_view name,
 
 std::expected<TriangleSoup, Error> parse_stl(std::span<const std::byte> bytes, std::string_view name,
                                              const MeshReadOptions& options) {
-  const detail::FileQuote quote(options.quote_file_text);
+  const io_detail::FileQuote quote(options.quote_file_text);
   const std::size_t size = bytes.size();
   if (size == 0) return std::unexpected(Error{ErrorCode::empty_mesh, fmt::format("{}: the file is empty", name)});
 
   const std::string_view text(reinterpret_cast<const char*>(bytes.data()), size);
-  const detail::StlProbe probe = detail::probe_stl(bytes, size);
+  const io_detail::StlProbe probe = io_detail::probe_stl(bytes, size);
   if (probe.ascii_like) {
-    auto ascii = detail::parse_stl_ascii(text, name, quote);
+    auto ascii = io_detail::parse_stl_ascii(text, name, quote);
     // A text-looking header whose size still matches a binary layout: trust the size.
     if (ascii || !probe.binary_fits) return ascii;
-    return detail::parse_stl_binary(bytes, name, quote);
+    return io_detail::parse_stl_binary(bytes, name, quote);
   }
-  if (probe.binary_fits) return detail::parse_stl_binary(bytes, name, quote);
+  if (probe.binary_fits) return io_detail::parse_stl_binary(bytes, name, quote);
 
   if (probe.text_prefix) {
     const std::string start =
-        quote.either(fmt::format(" (starts with {})", detail::quote_excerpt(skip_bom_and_space(text).substr(0, 24))), "");
+        quote.either(fmt::format(" (starts with {})", io_detail::quote_excerpt(skip_bom_and_space(text).substr(0, 24))), "");
     return std::unexpected(Error{
         ErrorCode::unknown_format, fmt::format("{}: not an STL file: text that does not start with 'solid'{}", name, start)});
   }
-  if (size < detail::kStlPreambleBytes) {
+  if (size < io_detail::kStlPreambleBytes) {
     return std::unexpected(
         Error{ErrorCode::unknown_format,
               fmt::format("{}: not an STL file: {} bytes is shorter than a binary STL's 84-byte header and count, "
                           "and it is not ASCII STL",
                           name, size)});
   }
-  return std::unexpected(detail::stl_short_binary_error(name, probe.declared, size, quote));
+  return std::unexpected(io_detail::stl_short_binary_error(name, probe.declared, size, quote));
 }
 
 }  // namespace lamina

@@ -62,7 +62,7 @@ class XmlTags {
       tag.closing = q < end_ && *q == '/';
       if (tag.closing) ++q;
       const char* name_begin = q;
-      while (q < end_ && !detail::is_space(*q) && *q != '/' && *q != '>') ++q;
+      while (q < end_ && !io_detail::is_space(*q) && *q != '/' && *q != '>') ++q;
       std::string_view name(name_begin, static_cast<std::size_t>(q - name_begin));
       if (const std::size_t colon = name.rfind(':'); colon != std::string_view::npos) name.remove_prefix(colon + 1);
       tag.name = name;
@@ -109,12 +109,12 @@ class XmlTags {
 std::optional<std::string_view> attribute(std::string_view attrs, std::string_view key, bool any_prefix = false) {
   std::size_t i = 0;
   const auto skip_space = [&] {
-    while (i < attrs.size() && detail::is_space(attrs[i])) ++i;
+    while (i < attrs.size() && io_detail::is_space(attrs[i])) ++i;
   };
   while (i < attrs.size()) {
     skip_space();
     const std::size_t name_begin = i;
-    while (i < attrs.size() && !detail::is_space(attrs[i]) && attrs[i] != '=') ++i;
+    while (i < attrs.size() && !io_detail::is_space(attrs[i]) && attrs[i] != '=') ++i;
     const std::string_view name = attrs.substr(name_begin, i - name_begin);
     skip_space();
     if (i >= attrs.size() || attrs[i] != '=') return std::nullopt;
@@ -134,19 +134,19 @@ std::optional<std::string_view> attribute(std::string_view attrs, std::string_vi
 }
 
 std::string_view trim(std::string_view s) {
-  while (!s.empty() && detail::is_space(s.front())) s.remove_prefix(1);
-  while (!s.empty() && detail::is_space(s.back())) s.remove_suffix(1);
+  while (!s.empty() && io_detail::is_space(s.front())) s.remove_prefix(1);
+  while (!s.empty() && io_detail::is_space(s.back())) s.remove_suffix(1);
   return s;
 }
 
 bool parse_float_value(std::string_view s, float& out) {
   s = trim(s);
-  return !s.empty() && detail::parse_float(s.data(), s.data() + s.size(), out) == s.data() + s.size();
+  return !s.empty() && io_detail::parse_float(s.data(), s.data() + s.size(), out) == s.data() + s.size();
 }
 
 bool parse_int_value(std::string_view s, std::int64_t& out) {
   s = trim(s);
-  return !s.empty() && detail::parse_int(s.data(), s.data() + s.size(), out) == s.data() + s.size();
+  return !s.empty() && io_detail::parse_int(s.data(), s.data() + s.size(), out) == s.data() + s.size();
 }
 
 // --- The model. -------------------------------------------------------------------------------
@@ -174,13 +174,13 @@ std::optional<Affine> parse_transform(std::string_view s) {
   const char* p = s.data();
   const char* end = s.data() + s.size();
   for (double& v : m) {
-    while (p < end && detail::is_space(*p)) ++p;
+    while (p < end && io_detail::is_space(*p)) ++p;
     if (p < end && *p == '+') ++p;
     const auto [next, ec] = std::from_chars(p, end, v);
     if (ec != std::errc{}) return std::nullopt;
     p = next;
   }
-  while (p < end && detail::is_space(*p)) ++p;
+  while (p < end && io_detail::is_space(*p)) ++p;
   if (p != end) return std::nullopt;
   Affine a;
   for (int i = 0; i < 3; ++i)
@@ -450,7 +450,7 @@ class ModelReader {
   void append_notes(TriangleSoup& soup) const {
     if (unit_ != "millimeter") {
       soup.notes.push_back({"units", fmt::format("{}: 3MF model unit is {} (coordinates kept as stored)", name_,
-                                                 quote_.either(detail::quote_excerpt(unit_), "not millimeter"))});
+                                                 quote_.either(io_detail::quote_excerpt(unit_), "not millimeter"))});
     }
     if (external_ > 0) {
       soup.notes.push_back({"3mf_external_skipped",
@@ -467,14 +467,14 @@ class ModelReader {
   };
 
   std::string part_label() const {
-    return quote_.quoting() ? detail::quote_excerpt(part_, 200) : "(" + quote_.text(part_, "a name") + ")";
+    return quote_.quoting() ? io_detail::quote_excerpt(part_, 200) : "(" + quote_.text(part_, "a name") + ")";
   }
 
   XmlTags tags_;
   std::string_view name_;
   std::string_view part_;
   const MeshReadOptions& options_;
-  detail::FileQuote quote_;
+  io_detail::FileQuote quote_;
   std::vector<Object> objects_;
   std::unordered_map<std::int64_t, std::size_t> index_;
   std::vector<Reference> items_;
@@ -489,7 +489,7 @@ class ModelReader {
 bool iequal_names(std::string_view a, std::string_view b) {
   if (a.size() != b.size()) return false;
   for (std::size_t i = 0; i < a.size(); ++i)
-    if (detail::ascii_lower(a[i]) != detail::ascii_lower(b[i])) return false;
+    if (io_detail::ascii_lower(a[i]) != io_detail::ascii_lower(b[i])) return false;
   return true;
 }
 
@@ -497,12 +497,12 @@ constexpr std::string_view kDefaultModelPart = "3D/3dmodel.model";
 
 // The root model part named by the package relationships, else the conventional path.
 std::expected<std::string, Error> model_part_name(std::span<const std::byte> zip,
-                                                  const std::vector<detail::ZipEntry>& entries, std::string_view name,
+                                                  const std::vector<io_detail::ZipEntry>& entries, std::string_view name,
                                                   const MeshReadOptions& options) {
   std::string part(kDefaultModelPart);
   for (const auto& e : entries) {
     if (!iequal_names(e.name, "_rels/.rels")) continue;
-    auto rels = detail::read_zip_entry(zip, e, name, options);
+    auto rels = io_detail::read_zip_entry(zip, e, name, options);
     if (!rels) return std::unexpected(rels.error());
     XmlTags tags(*rels);
     XmlTag tag;
@@ -526,17 +526,17 @@ std::expected<std::string, Error> model_part_name(std::span<const std::byte> zip
 
 std::expected<TriangleSoup, Error> parse_3mf(std::span<const std::byte> bytes, std::string_view name,
                                              const MeshReadOptions& options) {
-  const detail::FileQuote quote(options.quote_file_text);
-  auto entries = detail::list_zip(bytes, name, quote);
+  const io_detail::FileQuote quote(options.quote_file_text);
+  auto entries = io_detail::list_zip(bytes, name, quote);
   if (!entries) return std::unexpected(entries.error());
-  if (!detail::zip_support_compiled()) {
+  if (!io_detail::zip_support_compiled()) {
     return std::unexpected(Error{ErrorCode::unsupported,
                                  fmt::format("{}: 3MF is not supported yet (this build has no zlib)", name)});
   }
   const auto part = model_part_name(bytes, *entries, name, options);
   if (!part) return std::unexpected(part.error());
   const auto entry = std::find_if(entries->begin(), entries->end(),
-                                  [&](const detail::ZipEntry& e) { return iequal_names(e.name, *part); });
+                                  [&](const io_detail::ZipEntry& e) { return iequal_names(e.name, *part); });
   if (entry == entries->end()) {
     // The conventional name is ours to quote; one from the relationships is the file's.
     const std::string which = *part == kDefaultModelPart || quote.quoting()
@@ -545,7 +545,7 @@ std::expected<TriangleSoup, Error> parse_3mf(std::span<const std::byte> bytes, s
     return std::unexpected(Error{ErrorCode::unknown_format,
                                  fmt::format("{}: not a 3MF file: the zip has no model part {}", name, which)});
   }
-  auto xml = detail::read_zip_entry(bytes, *entry, name, options);
+  auto xml = io_detail::read_zip_entry(bytes, *entry, name, options);
   if (!xml) return std::unexpected(xml.error());
   return ModelReader(*xml, name, *part, options).read();
 }

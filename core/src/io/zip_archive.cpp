@@ -12,7 +12,7 @@
 #define LAMINA_ZIP_INFLATE 1
 #endif
 
-namespace lamina::detail {
+namespace lamina::io_detail {
 namespace {
 
 constexpr std::uint32_t kEndOfCentralDirectory = 0x06054b50;
@@ -324,4 +324,4 @@ std::expected<std::string, Error> read_zip_entry(std::span<const std::byte> zip,
 #endif
 }
 
-}  // namespace lamina::detail
+}  // namespace lamina::io_detail

@@ -14,7 +14,7 @@
 #include <string_view>
 #include <vector>
 
-namespace lamina::detail {
+namespace lamina::io_detail {
 
 struct ZipEntry {
   std::string name;
@@ -46,4 +46,4 @@ std::expected<std::vector<ZipEntry>, Error> list_zip(std::span<const std::byte> 
 std::expected<std::string, Error> read_zip_entry(std::span<const std::byte> zip, const ZipEntry& entry,
                                                  std::string_view name, const MeshReadOptions& options);
 
-}  // namespace lamina::detail
+}  // namespace lamina::io_detail

@@ -51,7 +51,7 @@ std::pair<std::int64_t, int> plan_key(double z_rel, int thickness_index) {
 
 // Plans the candidates (in batches of layers that do not overlap) and records each measure.
 // Returns how many were new.
-std::expected<int, Error> measure(Estimator& est, const Mesh& mesh, const detail::TriangleTree& model,
+std::expected<int, Error> measure(Estimator& est, const Mesh& mesh, const geometry_detail::TriangleTree& model,
                                   const LayeringParams& params, std::vector<Candidate> todo, PlanCache& plans) {
   const std::vector<double>& t = est.thicknesses();
   std::sort(todo.begin(), todo.end(), [](const Candidate& a, const Candidate& b) { return a.z_rel < b.z_rel; });
@@ -70,7 +70,7 @@ std::expected<int, Error> measure(Estimator& est, const Mesh& mesh, const detail
     std::vector<LayerSpan> spans;
     for (const Candidate& c : batch)
       spans.push_back(LayerSpan{est.z_base() + c.z_rel, t[static_cast<std::size_t>(c.thickness_index)]});
-    auto plan = detail::plan_bevels_on(mesh, &model, spans, bevel_params_of(params));
+    auto plan = bevel_detail::plan_bevels_on(mesh, &model, spans, bevel_params_of(params));
     if (!plan) return std::unexpected(plan.error());
     for (std::size_t i = 0; i < batch.size(); ++i) {
       const GridSpan span = est.span(batch[i].z_rel, t[static_cast<std::size_t>(batch[i].thickness_index)]);
@@ -102,7 +102,7 @@ std::vector<Candidate> unmeasured(const Estimator& est, const LayerChoice& choic
 
 std::expected<LayerChoice, Error> layer_verified(Estimator& est, const Mesh& mesh, const LayeringParams& params) {
   LayerChoice choice = layer_optimal(est, params);
-  std::optional<detail::TriangleTree> model;  // built once, for every round's plans
+  std::optional<geometry_detail::TriangleTree> model;  // built once, for every round's plans
   PlanCache plans;
   for (int round = 0; round < kMaxRounds; ++round) {
     if (choice.layers.empty() || choice.state_limit) break;

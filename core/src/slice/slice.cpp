@@ -207,7 +207,7 @@ void close_open_chains(const SliceParams& params, double z, Chains& c, Slice& sl
   if (slice.open_chains.empty()) return;
   if (params.gap_close_mm > 0.0) {
     std::vector<OpenChain> pending = slice.open_chains;
-    for (Loop& loop : detail::close_gaps(pending, params.gap_close_mm, slice.warnings)) {
+    for (Loop& loop : slice_detail::close_gaps(pending, params.gap_close_mm, slice.warnings)) {
       c.loops.push_back(std::move(loop));
       c.loop_shell.push_back(-1 - static_cast<int>(c.loop_shell.size()));
     }
@@ -220,14 +220,14 @@ void close_open_chains(const SliceParams& params, double z, Chains& c, Slice& sl
 // Loops of different shells that meet: their union. Where they only touch the union is the
 // loops themselves; report (and use) it only when it differs.
 void unite_shells(Chains& c, double z, Slice& slice) {
-  if (!detail::needs_union(c.loops, c.loop_shell)) return;
-  std::vector<Loop> merged = detail::union_of_loops(c.loops);
-  for (Loop& loop : merged) detail::compute_area(loop);
+  if (!slice_detail::needs_union(c.loops, c.loop_shell)) return;
+  std::vector<Loop> merged = slice_detail::union_of_loops(c.loops);
+  for (Loop& loop : merged) slice_detail::compute_area(loop);
   double before = 0.0, after = 0.0;
   for (const Loop& l : c.loops) before += l.area_mm2;
   for (const Loop& l : merged) after += l.area_mm2;
   if (merged.size() != c.loops.size() || std::abs(after - before) > 1e-12 * std::max(1.0, std::abs(before))) {
-    detail::compute_nesting(merged);
+    slice_detail::compute_nesting(merged);
     c.loops = std::move(merged);
     slice.warnings.push_back(fmt::format("z={:.4f} mm: overlapping shells, contours replaced by their union", z));
   }
@@ -249,8 +249,8 @@ Slice slice_one(const Mesh& mesh, std::span<const std::int32_t> faces, double z,
   for (std::int32_t i = 0; i < n; ++i)
     if (!s.used[static_cast<std::size_t>(i)]) trace_chain(mesh, s, i, z, c, slice);
   close_open_chains(params, z, c, slice);
-  for (Loop& loop : c.loops) detail::compute_area(loop);
-  detail::compute_nesting(c.loops);
+  for (Loop& loop : c.loops) slice_detail::compute_area(loop);
+  slice_detail::compute_nesting(c.loops);
   unite_shells(c, z, slice);
   slice.loops = std::move(c.loops);
   return slice;
@@ -322,7 +322,7 @@ std::expected<std::vector<Slice>, Error> slice_mesh(const Mesh& mesh, std::span<
   std::vector<double> sorted_z(zs.size());
   for (std::size_t i = 0; i < order.size(); ++i) sorted_z[i] = zs[order[i]];
 
-  const detail::FacetBuckets buckets = detail::bucket_facets(mesh, sorted_z);
+  const slice_detail::FacetBuckets buckets = slice_detail::bucket_facets(mesh, sorted_z);
 
   std::vector<Slice> out(zs.size());
   tbb::enumerable_thread_specific<Scratch> scratch;

@@ -9,7 +9,7 @@
 #include <algorithm>
 #include <cmath>
 
-namespace lamina::detail {
+namespace lamina::slice_detail {
 namespace {
 
 // upper_bound over sorted heights through a bin table: O(1) for evenly spread planes (the usual
@@ -112,4 +112,4 @@ FacetBuckets bucket_facets(const Mesh& mesh, std::span<const double> sorted_z) {
   return out;
 }
 
-}  // namespace lamina::detail
+}  // namespace lamina::slice_detail

@@ -8,7 +8,7 @@
 #include <algorithm>
 #include <tuple>
 
-namespace lamina::detail {
+namespace lamina::slice_detail {
 
 std::vector<Loop> close_gaps(std::vector<OpenChain>& chains, double gap_mm,
                              std::vector<std::string>& warnings) {
@@ -82,4 +82,4 @@ std::vector<Loop> close_gaps(std::vector<OpenChain>& chains, double gap_mm,
   return loops;
 }
 
-}  // namespace lamina::detail
+}  // namespace lamina::slice_detail

@@ -5,7 +5,7 @@
 #include <span>
 #include <vector>
 
-namespace lamina::detail {
+namespace lamina::slice_detail {
 
 // The facets each plane cuts: plane p's are faces[offsets[p] .. offsets[p + 1]), ascending.
 struct FacetBuckets {
@@ -38,4 +38,4 @@ std::vector<Loop> union_of_loops(const std::vector<Loop>& loops);
 // Winding number of p with respect to one loop (0 outside, +1 inside CCW, -1 inside CW).
 int winding_number(const Loop& loop, const Eigen::Vector2d& p);
 
-}  // namespace lamina::detail
+}  // namespace lamina::slice_detail

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <numeric>
 
-namespace lamina::detail {
+namespace lamina::slice_detail {
 
 void compute_area(Loop& loop) {
   const std::size_t n = loop.points.size();
@@ -112,4 +112,4 @@ void compute_nesting(std::vector<Loop>& loops) {
   }
 }
 
-}  // namespace lamina::detail
+}  // namespace lamina::slice_detail

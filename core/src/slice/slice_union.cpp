@@ -12,7 +12,7 @@
 #include <map>
 #include <set>
 
-namespace lamina::detail {
+namespace lamina::slice_detail {
 namespace {
 
 struct Seg {
@@ -246,4 +246,4 @@ std::vector<Loop> union_of_loops(const std::vector<Loop>& loops) {
   return chain_pieces(boundary_pieces(loops, splits, junctions));
 }
 
-}  // namespace lamina::detail
+}  // namespace lamina::slice_detail

@@ -17,7 +17,7 @@
 namespace lamina {
 namespace {
 
-using namespace sheet_svg_detail;
+using namespace svg_detail;
 using Vec2 = Eigen::Vector2d;
 
 // sheet_xy = R(rotation) · layer_xy + offset (nest.hpp). Local on purpose: the drawing needs

@@ -8,7 +8,7 @@
 #include <string_view>
 #include <vector>
 
-namespace lamina::sheet_svg_detail {
+namespace lamina::svg_detail {
 
 // At most 3 decimals, no trailing zeros, never "-0"; non-finite values print as 0.
 std::string num(double v);
@@ -49,4 +49,4 @@ Fragment legend(const LegendInfo& info, const Scale& s, double x, double y);
 // "1:02:05" (h:mm:ss), rounded to the second.
 std::string hms(double seconds);
 
-}  // namespace lamina::sheet_svg_detail
+}  // namespace lamina::svg_detail

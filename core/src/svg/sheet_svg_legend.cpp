@@ -8,7 +8,7 @@
 #include <iterator>
 #include <string_view>
 
-namespace lamina::sheet_svg_detail {
+namespace lamina::svg_detail {
 namespace {
 
 enum class Sample { line, dot, ring, mark };
@@ -125,4 +125,4 @@ Fragment legend(const LegendInfo& info, const Scale& s, double x, double y) {
   return Fragment{std::move(svg), w, h};
 }
 
-}  // namespace lamina::sheet_svg_detail
+}  // namespace lamina::svg_detail

@@ -6,7 +6,7 @@
 #include <algorithm>
 #include <cmath>
 
-namespace lamina::sheet_svg_detail {
+namespace lamina::svg_detail {
 
 std::string num(double v) {
   if (!std::isfinite(v)) return "0";
@@ -58,4 +58,4 @@ std::string hms(double seconds) {
   return fmt::format("{}:{:02}:{:02}", total / 3600, (total / 60) % 60, total % 60);
 }
 
-}  // namespace lamina::sheet_svg_detail
+}  // namespace lamina::svg_detail

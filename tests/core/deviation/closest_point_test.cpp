@@ -1,7 +1,7 @@
 // Point-to-triangle distance and the triangle tree behind max_mm: against dense sampling of the
 // triangles (every Voronoi region of a triangle, degenerate triangles), and the tree against a
 // brute-force scan, including its early stop.
-#include "deviation/closest_point.hpp"
+#include "geometry/closest_point.hpp"
 
 #include <gtest/gtest.h>
 
@@ -12,8 +12,8 @@
 namespace lamina {
 namespace {
 
-using detail::point_triangle_distance2;
-using detail::TriangleTree;
+using geometry_detail::point_triangle_distance2;
+using geometry_detail::TriangleTree;
 
 // Smallest distance from p to points of the triangle on a barycentric grid of n steps: an upper
 // bound of the true distance, within the grid's spacing of it.
@@ -89,7 +89,7 @@ TEST(TriangleTreeTest, MortonOrderKeepsThePoints) {
   std::vector<Eigen::Vector3d> pts;
   for (int i = 0; i < 1000; ++i) pts.emplace_back(u(rng), u(rng), u(rng));
   auto sorted = pts;
-  detail::sort_morton(sorted, true);
+  geometry_detail::sort_morton(sorted, true);
   auto key = [](const Eigen::Vector3d& v) { return std::tuple(v.x(), v.y(), v.z()); };
   auto a = pts, b = sorted;
   std::sort(a.begin(), a.end(), [&](auto& x, auto& y) { return key(x) < key(y); });

@@ -16,7 +16,7 @@
 namespace lamina {
 namespace {
 
-using detail::triangulate_polygon_with_holes;
+using geometry_detail::triangulate_polygon_with_holes;
 using Tris = std::vector<std::array<std::int32_t, 3>>;
 
 std::vector<Eigen::Vector2d> all_points(const Polygon2& outer, const std::vector<Polygon2>& holes) {
@@ -227,8 +227,8 @@ TEST(Triangulation, LargeRingsTileInAboutLinearWork) {
   spiral.insert(spiral.end(), spiral_out.rbegin(), spiral_out.rend());
   if (signed_area_mm2(spiral) < 0) spiral = reversed(spiral);
   for (const auto& [what, ring] : {std::pair{"circle", circle}, {"star", star}, {"spiral", spiral}, {"comb", comb}}) {
-    detail::TriangulationWork work;
-    const Tris tris = triangulate_polygon_with_holes(ring, {}, detail::kCapStraightSine, &work);
+    geometry_detail::TriangulationWork work;
+    const Tris tris = triangulate_polygon_with_holes(ring, {}, geometry_detail::kCapStraightSine, &work);
     EXPECT_FALSE(work.exhausted) << what;
     EXPECT_LT(work.steps, 20 * ring.size() * std::bit_width(ring.size())) << what << ": " << work.steps / ring.size();
     expect_tiling(ring, {}, what);
@@ -243,8 +243,8 @@ TEST(Triangulation, ASelfCrossingLargeRingStaysBoundedAndClosed) {
   Polygon2 noise;
   for (int i = 0; i < 20000; ++i) noise.emplace_back(u(rng), u(rng));
   if (signed_area_mm2(noise) < 0) noise = reversed(noise);  // as given, so the edges read the same way
-  detail::TriangulationWork work;
-  const Tris tris = triangulate_polygon_with_holes(noise, {}, detail::kCapStraightSine, &work);
+  geometry_detail::TriangulationWork work;
+  const Tris tris = triangulate_polygon_with_holes(noise, {}, geometry_detail::kCapStraightSine, &work);
   EXPECT_EQ(tris.size(), noise.size() - 2);
   EXPECT_TRUE(work.exhausted);
   EXPECT_LT(work.steps, (std::uint64_t{1} << 20) + 33 * noise.size() * std::bit_width(noise.size()));

@@ -74,8 +74,8 @@ TEST(LargeFaces, EarClippingWorkIsAboutLinear) {
     const auto corners = in_3d(ring);
     const std::size_t n = corners.size();
     std::vector<std::array<std::uint32_t, 3>> tris;
-    detail::EarClippingScratch scratch;
-    ASSERT_TRUE(detail::triangulate_polygon(corners, tris, scratch)) << what;
+    geometry_detail::EarClippingScratch scratch;
+    ASSERT_TRUE(geometry_detail::triangulate_polygon(corners, tris, scratch)) << what;
     ASSERT_EQ(tris.size(), n - 2) << what;
     // Each ear tested against every corner: n²/2 = 2·10^8 steps here. n log n allows ~300·n.
     EXPECT_LT(scratch.steps, 20 * n * std::bit_width(n)) << what << ": " << scratch.steps / n << " steps a corner";

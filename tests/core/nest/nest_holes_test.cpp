@@ -50,23 +50,23 @@ bool point_in(const Paths& region, ClipperLib::IntPoint q) {
 
 double area_of(const Paths& a) { return nest_test::area_mm2(a); }
 
-Paths clip(ClipperLib::ClipType op, const Paths& a, const Paths& b) { return detail::boolean(op, a, b); }
+Paths clip(ClipperLib::ClipType op, const Paths& a, const Paths& b) { return cam_detail::boolean(op, a, b); }
 
 // Random t: C + t inside the room exactly when t is in inner_fit (away from the region's edge,
 // where rounding to nm decides); C + t overlaps G exactly when t is in G ⊕ (−C).
 void brute_force(const Paths& room, const Path& c, const Path& g, std::mt19937& rng, const char* what) {
   SCOPED_TRACE(what);
-  const Paths fit = detail::inner_fit(room, c);
-  const Paths nfp = detail::minkowski_sum(g, detail::negated(c));
-  const Paths fit_edge = detail::offset_mitre(fit, 1e-3);
-  const Paths fit_core = detail::offset_mitre(fit, -1e-3);
-  const Paths nfp_edge = detail::offset_mitre(nfp, 1e-3);
-  const Paths nfp_core = detail::offset_mitre(nfp, -1e-3);
+  const Paths fit = cam_detail::inner_fit(room, c);
+  const Paths nfp = cam_detail::minkowski_sum(g, cam_detail::negated(c));
+  const Paths fit_edge = cam_detail::offset_mitre(fit, 1e-3);
+  const Paths fit_core = cam_detail::offset_mitre(fit, -1e-3);
+  const Paths nfp_edge = cam_detail::offset_mitre(nfp, 1e-3);
+  const Paths nfp_core = cam_detail::offset_mitre(nfp, -1e-3);
   std::uniform_real_distribution<double> u(-150.0, 150.0);
   int inside = 0, overlapping = 0;
   for (int k = 0; k < 400; ++k) {
     const ClipperLib::IntPoint t{std::llround(u(rng) * kNm), std::llround(u(rng) * kNm)};
-    const Paths moved{detail::translated(c, t)};
+    const Paths moved{cam_detail::translated(c, t)};
     const bool in_room = area_of(clip(ClipperLib::ctDifference, moved, room)) == 0.0;
     if (point_in(fit_core, t) || !point_in(fit_edge, t)) {
       EXPECT_EQ(in_room, point_in(fit, t)) << "t = " << t.X * 1e-6 << ", " << t.Y * 1e-6;
@@ -100,9 +100,9 @@ TEST(NestFit, ConvexShortcutEqualsTheGeneralFormula) {
   std::uniform_real_distribution<double> r(20.0, 60.0);
   for (int k = 0; k < 20; ++k) {
     const Path room = to_path(circle(100.0 + r(rng), 7 + k));
-    const Path c = ClipperLib::Path(detail::convex_hull(to_path(circle(r(rng), 3 + k % 9, r(rng) - 40, 3.0))));
-    const Paths a = detail::inner_fit({room}, c);
-    const Paths b = detail::inner_fit_general({room}, c);
+    const Path c = ClipperLib::Path(cam_detail::convex_hull(to_path(circle(r(rng), 3 + k % 9, r(rng) - 40, 3.0))));
+    const Paths a = cam_detail::inner_fit({room}, c);
+    const Paths b = cam_detail::inner_fit_general({room}, c);
     ASSERT_FALSE(a.empty());
     const double xor_area = area_of(clip(ClipperLib::ctXor, a, b));
     EXPECT_LT(xor_area, 1e-4) << "case " << k << ": areas " << area_of(a) << " vs " << area_of(b);
@@ -117,8 +117,8 @@ TEST(NestFit, InnerProxyOfANearlyConvexHoleIsInsideItAndSmall) {
   Polygon2 noisy = circle(80, 400);
   for (auto& p : noisy) p *= 1.0 - dent(rng) / 80.0;
   const Path ring = to_path(noisy);
-  ASSERT_FALSE(detail::is_convex(ring));
-  const Path proxy = detail::inner_proxy(ring);
+  ASSERT_FALSE(cam_detail::is_convex(ring));
+  const Path proxy = cam_detail::inner_proxy(ring);
   EXPECT_LE(proxy.size(), 64u);
   EXPECT_EQ(area_of(clip(ClipperLib::ctDifference, {proxy}, {ring})), 0.0) << "the proxy must lie inside the hole";
   // It gives up little: a 64-gon in the R 80 circle, less the 20 µm pockets.
@@ -136,14 +136,14 @@ TEST(NestFit, InnerProxyOfANearlyConvexHoleIsInsideItAndSmall) {
       dented.push_back(k == 0 ? p : Eigen::Vector2d(p + dent(rng) * inward.normalized()));
     }
   const Path square_ring = to_path(dented);
-  const Path square_proxy = detail::inner_proxy(square_ring);
+  const Path square_proxy = cam_detail::inner_proxy(square_ring);
   EXPECT_EQ(area_of(clip(ClipperLib::ctDifference, {square_proxy}, {square_ring})), 0.0);
   EXPECT_GT(area_of({square_proxy}), 0.999 * 100 * 100);
 
   Polygon2 notched = circle(80, 400);
   for (int i = 0; i < 5; ++i) notched[static_cast<std::size_t>(i)] *= 75.0 / 80.0;
   const Path deep = to_path(notched);
-  EXPECT_EQ(detail::inner_proxy(deep), deep);  // a real pocket: the ring itself
+  EXPECT_EQ(cam_detail::inner_proxy(deep), deep);  // a real pocket: the ring itself
 }
 
 // A U of many corners, as a layer of a vase cut along its axis comes out: two round-ended walls
@@ -163,32 +163,32 @@ Path vase_u(int n, double scale = 1.0) {
 
 TEST(NestFit, SimplifiedOutsideHoldsTheRingCloselyWithFewerCorners) {
   const Path u = vase_u(300);
-  ASSERT_FALSE(detail::is_convex(u));
-  const Path s = detail::simplified_outside(u);
+  ASSERT_FALSE(cam_detail::is_convex(u));
+  const Path s = cam_detail::simplified_outside(u);
   EXPECT_LT(s.size(), u.size() / 2) << "the many corners of the arcs should go";
   EXPECT_EQ(area_of(clip(ClipperLib::ctDifference, {u}, {s})), 0.0) << "the proxy must hold the ring";
   // No farther out than 75 µm anywhere: inside the ring grown by that much.
-  EXPECT_EQ(area_of(clip(ClipperLib::ctDifference, {s}, detail::offset_mitre({u}, 0.075))), 0.0);
-  EXPECT_EQ(detail::outer_proxy(u), s);  // the U is far from its hull: outer_proxy simplifies it
+  EXPECT_EQ(area_of(clip(ClipperLib::ctDifference, {s}, cam_detail::offset_mitre({u}, 0.075))), 0.0);
+  EXPECT_EQ(cam_detail::outer_proxy(u), s);  // the U is far from its hull: outer_proxy simplifies it
 }
 
 TEST(NestFit, WithoutNoFitEqualsSubtractingEachNoFitRegion) {
   // Concave and convex children and candidates, the fit region small and large: the windowed,
   // un-united pieces take exactly what the whole no-fit regions take.
-  const Path big = detail::convex_hull(to_path(circle(140, 64)));
+  const Path big = cam_detail::convex_hull(to_path(circle(140, 64)));
   const Path u = vase_u(40, 0.5);
   const Path l_shape = to_path(ell(30, 20, 8, -10, -10));
-  const std::vector<Path> children{detail::translated(u, {-60'000'000, 20'000'000}),
-                                   detail::translated(l_shape, {50'000'000, -40'000'000}),
+  const std::vector<Path> children{cam_detail::translated(u, {-60'000'000, 20'000'000}),
+                                   cam_detail::translated(l_shape, {50'000'000, -40'000'000}),
                                    to_path(triangle(20, 15, 10, 60))};
   for (const Path& c : {u, l_shape, to_path(rect(12, 8, -6, -4))}) {
-    const Paths fit = detail::inner_fit({big}, c);
+    const Paths fit = cam_detail::inner_fit({big}, c);
     ASSERT_FALSE(fit.empty());
     const Paths small = clip(ClipperLib::ctIntersection, fit, {to_path(rect(40, 30, -50, -10))});
     for (const Paths& f : {fit, small}) {
       Paths want = f;
-      for (const Path& g : children) want = clip(ClipperLib::ctDifference, want, detail::minkowski_sum(g, detail::negated(c)));
-      const Paths got = detail::without_no_fit(f, children, c);
+      for (const Path& g : children) want = clip(ClipperLib::ctDifference, want, cam_detail::minkowski_sum(g, cam_detail::negated(c)));
+      const Paths got = cam_detail::without_no_fit(f, children, c);
       EXPECT_GT(area_of(got), 0.0);
       EXPECT_LT(area_of(clip(ClipperLib::ctXor, got, want)), 1e-6) << area_of(got) << " vs " << area_of(want);
     }
@@ -198,8 +198,8 @@ TEST(NestFit, WithoutNoFitEqualsSubtractingEachNoFitRegion) {
 TEST(NestFit, ConvexRoomHoldsAConcaveRingExactlyWhenItHoldsItsHull) {
   const Path room = to_path(circle(120, 40));
   const Path u = vase_u(60, 0.8);
-  const Paths a = detail::inner_fit({room}, u);
-  const Paths b = detail::inner_fit_general({room}, u);
+  const Paths a = cam_detail::inner_fit({room}, u);
+  const Paths b = cam_detail::inner_fit_general({room}, u);
   ASSERT_FALSE(a.empty());
   EXPECT_LT(area_of(clip(ClipperLib::ctXor, a, b)), 1e-4) << area_of(a) << " vs " << area_of(b);
 }
@@ -207,7 +207,7 @@ TEST(NestFit, ConvexRoomHoldsAConcaveRingExactlyWhenItHoldsItsHull) {
 TEST(NestHoles, ComposedPlacementIsHostAfterChild) {
   const Placement host{0, 1.1, {300.0, -20.0}};
   const Placement child{1, 0.7, {12.0, 5.5}};
-  const Placement sheet = detail::compose(host, child);
+  const Placement sheet = cam_detail::compose(host, child);
   for (const Eigen::Vector2d& p : {Eigen::Vector2d(3, 4), Eigen::Vector2d(-50, 8)}) {
     const Eigen::Vector2d want = place_point(host, place_point(child, p));
     EXPECT_LT((place_point(sheet, p) - want).norm(), 1e-12);
@@ -278,7 +278,7 @@ TEST_P(NestHoles, SmallPartsGoInsideTheBigRing) {
   const NestParams params = with(GetParam());
   std::vector<int> group(parts.size());
   for (std::size_t i = 0; i < parts.size(); ++i) group[i] = static_cast<int>(i);
-  const detail::HoleFilling fill = detail::fill_holes(parts, group, params);
+  const cam_detail::HoleFilling fill = cam_detail::fill_holes(parts, group, params);
   EXPECT_EQ(fill.rejected_by_check, 0);
   ASSERT_EQ(fill.hosted.size(), parts.size() - 1) << "every small part fits the Ø180 hole";
   ASSERT_EQ(fill.free, std::vector<int>{0});
@@ -401,7 +401,7 @@ TEST_P(NestHoles, SeededRandomRingsAndSmallParts) {
       std::vector<int> group;
       for (std::size_t i = 0; i < parts.size(); ++i)
         if (parts[i].thickness_mm == t) group.push_back(static_cast<int>(i));
-      EXPECT_EQ(detail::fill_holes(parts, group, params).rejected_by_check, 0);
+      EXPECT_EQ(cam_detail::fill_holes(parts, group, params).rejected_by_check, 0);
     }
     auto with_fill = nest_parts(parts, stock, params);
     ASSERT_TRUE(with_fill) << with_fill.error().message;

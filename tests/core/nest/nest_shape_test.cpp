@@ -33,8 +33,8 @@ TEST(NestShape, PlacementReproducesLibnest2dTransform) {
     which.push_back(i);
   }
   std::vector<int> unplaced;
-  detail::ShapePackDiagnostics diag;
-  const auto sheets = detail::pack_shape(parts, which, {400, 300}, with(NestMethod::shape), unplaced, &diag);
+  cam_detail::ShapePackDiagnostics diag;
+  const auto sheets = cam_detail::pack_shape(parts, which, {400, 300}, with(NestMethod::shape), unplaced, &diag);
   EXPECT_TRUE(unplaced.empty());
   EXPECT_EQ(diag.items, 12);
   EXPECT_LT(diag.max_transform_error_mm, 2e-6);

@@ -1,4 +1,4 @@
-#include "deviation/closest_point.hpp"
+#include "geometry/closest_point.hpp"
 
 #include <tbb/parallel_invoke.h>
 #include <tbb/parallel_sort.h>
@@ -8,7 +8,7 @@
 #include <limits>
 #include <map>
 
-namespace lamina::detail {
+namespace lamina::geometry_detail {
 
 namespace {
 
@@ -224,4 +224,4 @@ double TriangleTree::distance(const Eigen::Vector3d& p, double enough, std::int3
   return std::sqrt(best2);
 }
 
-}  // namespace lamina::detail
+}  // namespace lamina::geometry_detail

@@ -7,7 +7,7 @@
 #include <cstdint>
 #include <vector>
 
-namespace lamina::detail {
+namespace lamina::geometry_detail {
 
 // Squared distance from p to the triangle abc (closest point by Voronoi regions, Ericson 5.1.5);
 // degenerate triangles are measured as their edges.
@@ -42,4 +42,4 @@ class TriangleTree {
   std::vector<std::array<Eigen::Vector3d, 3>> tris_;  // in leaf order
 };
 
-}  // namespace lamina::detail
+}  // namespace lamina::geometry_detail
