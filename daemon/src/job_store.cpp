@@ -90,6 +90,7 @@ constexpr const char* kUpdateSheetProgress =
 constexpr const char* kInsertEvent = "INSERT INTO events (job_id, t_unix_ms, kind, data) VALUES (?1, ?2, ?3, ?4)";
 
 using sqlite::Connection;
+using Access = sqlite::Connection::Access;
 using sqlite::Fail;
 using sqlite::Statement;
 
@@ -132,7 +133,7 @@ std::expected<void, StoreError> prepare_database(Connection& db) {
   if (*version == kSchemaVersion) return {};
 
   // BEGIN IMMEDIATE and a second look: another process may have created the schema meanwhile.
-  return db.transaction("open: create the schema", true, [&]() -> std::expected<void, StoreError> {
+  return db.transaction("open: create the schema", Access::write, [&]() -> std::expected<void, StoreError> {
     auto again = db.single_integer("PRAGMA user_version", "read the schema version");
     if (!again) return Fail(again.error());
     if (*again == kSchemaVersion) return {};
@@ -275,7 +276,7 @@ std::expected<void, StoreError> JobStore::check_file() const {
 std::expected<void, StoreError> JobStore::insert_job(const JobRecord& job) {
   std::lock_guard lock(impl_->mutex);
   Connection& db = impl_->db;
-  return db.transaction(fmt::format("insert job {}", job.id), true, [&]() -> std::expected<void, StoreError> {
+  return db.transaction(fmt::format("insert job {}", job.id), Access::write, [&]() -> std::expected<void, StoreError> {
     auto s = db.statement(kInsertJob, "insert the job");
     if (!s) return Fail(s.error());
     bind_job(*s, job);
@@ -287,7 +288,7 @@ std::expected<void, StoreError> JobStore::insert_job(const JobRecord& job) {
 std::expected<void, StoreError> JobStore::update_job(const JobRecord& job) {
   std::lock_guard lock(impl_->mutex);
   Connection& db = impl_->db;
-  return db.transaction(fmt::format("update job {}", job.id), true, [&]() -> std::expected<void, StoreError> {
+  return db.transaction(fmt::format("update job {}", job.id), Access::write, [&]() -> std::expected<void, StoreError> {
     auto s = db.statement(kUpdateJob, "update the job");
     if (!s) return Fail(s.error());
     bind_job(*s, job);
@@ -302,7 +303,7 @@ std::expected<void, StoreError> JobStore::update_job(const JobRecord& job) {
 std::expected<void, StoreError> JobStore::update_sheet(const std::string& job_id, const SheetRecord& sheet) {
   std::lock_guard lock(impl_->mutex);
   Connection& db = impl_->db;
-  return db.transaction(fmt::format("update sheet {} of job {}", sheet.index, job_id), true,
+  return db.transaction(fmt::format("update sheet {} of job {}", sheet.index, job_id), Access::write,
                         [&]() -> std::expected<void, StoreError> {
                           auto s = db.statement(kUpdateSheetProgress, "update the sheet");
                           if (!s) return Fail(s.error());
@@ -317,7 +318,7 @@ std::expected<std::optional<JobRecord>, StoreError> JobStore::get_job(const std:
   std::lock_guard lock(impl_->mutex);
   Connection& db = impl_->db;
   using Result = std::expected<std::optional<JobRecord>, StoreError>;
-  return db.transaction(fmt::format("read job {}", id), false, [&]() -> Result {
+  return db.transaction(fmt::format("read job {}", id), Access::read, [&]() -> Result {
     std::optional<JobRecord> job;
     {
       auto s = db.statement(kSelectJob, "read the job");
@@ -339,7 +340,7 @@ std::expected<std::vector<JobRecord>, StoreError> JobStore::list_jobs() const {
   std::lock_guard lock(impl_->mutex);
   Connection& db = impl_->db;
   using Result = std::expected<std::vector<JobRecord>, StoreError>;
-  return db.transaction("list jobs", false, [&]() -> Result {
+  return db.transaction("list jobs", Access::read, [&]() -> Result {
     std::vector<JobRecord> jobs;
     {
       auto s = db.statement(kSelectJobs, "read the jobs");
@@ -362,7 +363,7 @@ std::expected<std::vector<JobRecord>, StoreError> JobStore::list_jobs() const {
 std::expected<void, StoreError> JobStore::add_event(const JobEvent& event) {
   std::lock_guard lock(impl_->mutex);
   Connection& db = impl_->db;
-  return db.transaction(fmt::format("add a {} event to job {}", event.kind, event.job_id), true,
+  return db.transaction(fmt::format("add a {} event to job {}", event.kind, event.job_id), Access::write,
                         [&] { return insert_event(db, event); });
 }
 
@@ -370,7 +371,7 @@ std::expected<std::vector<JobEvent>, StoreError> JobStore::events(const std::str
   std::lock_guard lock(impl_->mutex);
   Connection& db = impl_->db;
   using Result = std::expected<std::vector<JobEvent>, StoreError>;
-  return db.transaction(fmt::format("read the events of job {}", job_id), false, [&]() -> Result {
+  return db.transaction(fmt::format("read the events of job {}", job_id), Access::read, [&]() -> Result {
     auto s = db.statement("SELECT t_unix_ms, kind, data FROM events WHERE job_id = ?1 ORDER BY id", "read events");
     if (!s) return Fail(s.error());
     s->bind(job_id);
@@ -390,7 +391,7 @@ std::expected<std::vector<std::string>, StoreError> JobStore::recover_after_rest
   std::lock_guard lock(impl_->mutex);
   Connection& db = impl_->db;
   using Result = std::expected<std::vector<std::string>, StoreError>;
-  return db.transaction("recover after a restart", true, [&]() -> Result {
+  return db.transaction("recover after a restart", Access::write, [&]() -> Result {
     struct Found {
       std::string id;
       JobState state;

@@ -55,7 +55,7 @@ bool Connection::evictable(std::chrono::steady_clock::time_point now) const {
 // The pre-auth deadline of a TCP peer without a valid token yet, else the idle timeout; moved
 // on by every request (expires_after cancels the wait before).
 void Connection::arm_idle_timer() {
-  const bool pre_auth = context_.via_tcp && !authenticated_;
+  const bool pre_auth = context_.via == Via::tcp && !authenticated_;
   const double seconds = pre_auth ? shared_->settings.pre_auth_timeout_s : shared_->settings.idle_timeout_s;
   if (seconds <= 0) return;
   if (!idle_timer_) idle_timer_.emplace(socket_.get_executor());
@@ -100,7 +100,7 @@ void Connection::on_read(const boost::system::error_code& error, std::size_t siz
     return;
   }
   // Before its token, a TCP peer gets a few KiB per line, not the MiB a client may send.
-  const std::size_t limit = context_.via_tcp && !authenticated_ ? shared_->settings.pre_auth_max_bytes
+  const std::size_t limit = context_.via == Via::tcp && !authenticated_ ? shared_->settings.pre_auth_max_bytes
                                                                 : shared_->settings.max_request_bytes;
   std::string_view data(chunk_.data(), size);
   while (!closed_ && !draining_) {
@@ -165,13 +165,13 @@ std::optional<RpcRequest> Connection::accept_request(std::string_view line) {
   auto parsed = parse_request(line);
   if (!parsed) {
     shared_->log->info("client {}: {} ({})", context_.id, parsed.error().error.message, parsed.error().error.code);
-    if (context_.via_tcp && !authenticated_)  // a stranger gets one answer, not a parser to play with
+    if (context_.via == Via::tcp && !authenticated_)  // a stranger gets one answer, not a parser to play with
       refuse_and_hang_up(error_line(parsed.error().id, parsed.error().error), "bad request before a valid token");
     else
       send_line(error_line(parsed.error().id, parsed.error().error));
     return std::nullopt;
   }
-  if (context_.via_tcp) {
+  if (context_.via == Via::tcp) {
     if (auto authorized = check_and_strip_token(parsed->params, shared_->settings.token); !authorized) {
       shared_->log->warn("client {} ({}): {} without a valid token", context_.id, peer_, parsed->method);
       const std::string reply = error_line(parsed->id, authorized.error());
@@ -206,7 +206,7 @@ void Connection::dispatch_next() {
     if (!request) {  // a long line: parsed here, its token checked here
       auto parsed = parse_request(next.raw);
       if (!parsed) result = std::unexpected(parsed.error().error), id = parsed.error().id;
-      else if (auto ok = context.via_tcp ? check_and_strip_token(parsed->params, self->shared_->settings.token)
+      else if (auto ok = context.via == Via::tcp ? check_and_strip_token(parsed->params, self->shared_->settings.token)
                                          : std::expected<void, RpcError>{};
                !ok)
         result = std::unexpected(ok.error()), id = parsed->id;
@@ -254,7 +254,7 @@ RpcResult Connection::invoke(const RpcRequest& request, ClientContext& context) 
 void Connection::send_line(std::string line) { send(std::make_shared<const std::string>(std::move(line))); }
 
 void Connection::refuse_oversize(std::size_t bytes) {
-  const std::size_t limit = context_.via_tcp && !authenticated_ ? shared_->settings.pre_auth_max_bytes
+  const std::size_t limit = context_.via == Via::tcp && !authenticated_ ? shared_->settings.pre_auth_max_bytes
                                                                 : shared_->settings.max_request_bytes;
   shared_->log->warn("client {} ({}): request of {} bytes over the limit of {}; closing", context_.id, peer_, bytes,
                      limit);

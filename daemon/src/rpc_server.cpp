@@ -145,8 +145,8 @@ struct RpcServer::Impl : std::enable_shared_from_this<RpcServer::Impl> {
         return opened;
       }
     }
-    if (want_unix) accept_next(*unix_acceptor, false);
-    if (want_tcp) accept_next(*tcp_acceptor, true);
+    if (want_unix) accept_next(*unix_acceptor, Via::unix_socket);
+    if (want_tcp) accept_next(*tcp_acceptor, Via::tcp);
     return {};
   }
 
@@ -225,28 +225,28 @@ struct RpcServer::Impl : std::enable_shared_from_this<RpcServer::Impl> {
   }
 
   template <typename Acceptor>
-  void accept_next(Acceptor& acceptor, bool via_tcp) {
+  void accept_next(Acceptor& acceptor, Via via) {
     acceptor.async_accept(
-        [self = shared_from_this(), &acceptor, via_tcp](const boost::system::error_code& error, auto socket) {
+        [self = shared_from_this(), &acceptor, via](const boost::system::error_code& error, auto socket) {
           std::lock_guard lock(self->shared->mutex);
-          self->on_accept(acceptor, via_tcp, error, std::move(socket));
+          self->on_accept(acceptor, via, error, std::move(socket));
         });
   }
 
   template <typename Acceptor, typename Socket>
-  void on_accept(Acceptor& acceptor, bool via_tcp, const boost::system::error_code& error, Socket socket) {
+  void on_accept(Acceptor& acceptor, Via via, const boost::system::error_code& error, Socket socket) {
     if (stopped || error == boost::asio::error::operation_aborted) return;
     if (error) {
       // EMFILE and the like: accepting again at once would spin while nothing frees descriptors.
-      log().warn("accepting a {} client failed: {}; retrying", via_tcp ? "TCP" : "Unix", error.message());
+      log().warn("accepting a {} client failed: {}; retrying", via_name(via), error.message());
       auto timer = std::make_shared<boost::asio::steady_timer>(io, std::chrono::milliseconds(100));
-      timer->async_wait([self = shared_from_this(), timer, &acceptor, via_tcp](const boost::system::error_code& e) {
+      timer->async_wait([self = shared_from_this(), timer, &acceptor, via](const boost::system::error_code& e) {
         std::lock_guard lock(self->shared->mutex);
-        if (!e && !self->stopped) self->accept_next(acceptor, via_tcp);
+        if (!e && !self->stopped) self->accept_next(acceptor, via);
       });
       return;
     }
-    accept_next(acceptor, via_tcp);
+    accept_next(acceptor, via);
     std::string peer;
     if constexpr (std::is_same_v<typename Socket::protocol_type, tcp>) {
       boost::system::error_code ignored;
@@ -255,38 +255,38 @@ struct RpcServer::Impl : std::enable_shared_from_this<RpcServer::Impl> {
     } else {
       peer = unix_peer(socket.native_handle());
     }
-    if (count(via_tcp) >= settings().max_clients && !evict_one(via_tcp)) {
-      refuse(socket, peer, via_tcp);
+    if (count(via) >= settings().max_clients && !evict_one(via)) {
+      refuse(socket, peer, via);
       return;
     }
-    admit(std::move(socket), via_tcp, std::move(peer));
+    admit(std::move(socket), via, std::move(peer));
   }
 
-  std::size_t count(bool via_tcp) const {
+  std::size_t count(Via via) const {
     std::size_t n = 0;
-    for (const auto& [id, connection] : connections) n += connection->context().via_tcp == via_tcp;
+    for (const auto& [id, connection] : connections) n += connection->context().via == via;
     return n;
   }
 
   // 128 idle connections used to lock every new client out until a restart: the longest-idle
   // one of the same kind makes room (never a subscriber, nor one with a request in flight).
-  bool evict_one(bool via_tcp) {
+  bool evict_one(Via via) {
     const auto now = std::chrono::steady_clock::now();
     std::shared_ptr<Connection> oldest;
     for (const auto& [id, connection] : connections)
-      if (connection->context().via_tcp == via_tcp && connection->evictable(now) &&
+      if (connection->context().via == via && connection->evictable(now) &&
           (!oldest || connection->last_active() < oldest->last_active()))
         oldest = connection;
     if (!oldest) return false;
     oldest->close(fmt::format("the longest idle of {} {} clients, dropped to make room", settings().max_clients,
-                              via_tcp ? "TCP" : "Unix"));
+                              via_name(via)));
     return true;
   }
 
   template <typename Socket>
-  void refuse(Socket& socket, const std::string& peer, bool via_tcp) {
-    const char* kind = via_tcp ? "TCP" : "Unix";
-    log().warn("refusing {}: {} {} clients connected, none idle (max_clients)", peer, count(via_tcp), kind);
+  void refuse(Socket& socket, const std::string& peer, Via via) {
+    const char* kind = via_name(via);
+    log().warn("refusing {}: {} {} clients connected, none idle (max_clients)", peer, count(via), kind);
     const std::string line = rpc_detail::error_line(
         nullptr, RpcError{rpc_detail::too_many_clients,
                           fmt::format("too many {} clients (limit {}, none idle)", kind, settings().max_clients), {}});
@@ -298,7 +298,7 @@ struct RpcServer::Impl : std::enable_shared_from_this<RpcServer::Impl> {
   }
 
   template <typename Socket>
-  void admit(Socket socket, bool via_tcp, std::string peer) {
+  void admit(Socket socket, Via via, std::string peer) {
     // One socket type for both kinds of client (see Connection::Socket).
     boost::system::error_code error;
     const boost::asio::generic::stream_protocol protocol(socket.local_endpoint(error).protocol());
@@ -314,7 +314,7 @@ struct RpcServer::Impl : std::enable_shared_from_this<RpcServer::Impl> {
       log().warn("cannot take over the socket of {}: {}", peer, error.message());
       return;
     }
-    const ClientContext context{next_client_id++, via_tcp, false};
+    const ClientContext context{next_client_id++, via, false};
     auto connection = std::make_shared<Connection>(
         std::move(generic), context, std::move(peer), shared, [weak = weak_from_this()](std::uint64_t id) {
           // Runs inside Connection::close, under the lock.
@@ -399,7 +399,7 @@ std::expected<void, std::string> RpcServer::adopt_unix_listener(int fd) {
   acceptor.assign(UnixProtocol(), fd, error);
   if (error) return std::unexpected(fmt::format("cannot adopt fd {}: {}", fd, error.message()));
   impl_->unix_acceptor.emplace(std::move(acceptor));
-  impl_->accept_next(*impl_->unix_acceptor, false);
+  impl_->accept_next(*impl_->unix_acceptor, Via::unix_socket);
   impl_->log().info("listening on the Unix socket passed by systemd (fd {})", fd);
   return {};
 }
@@ -425,6 +425,8 @@ void RpcServer::stop() {
   std::lock_guard lock(impl_->shared->mutex);
   impl_->stop("server stopping");
 }
+
+const char* via_name(Via via) { return via == Via::tcp ? "TCP" : "Unix"; }
 
 std::size_t RpcServer::client_count() const { return impl_->clients.load(); }
 

@@ -117,8 +117,10 @@ class Connection {
 
   // Runs `body` (returning std::expected<T, StoreError>) inside BEGIN … COMMIT, rolled back on
   // any failure or exception. Errors come back as "<file>: <context>: <what failed>".
+  enum class Access : bool { read, write };  // a write takes the lock at BEGIN (IMMEDIATE)
   template <typename Body>
-  auto transaction(std::string_view context, bool write, Body&& body) -> decltype(body()) {
+  auto transaction(std::string_view context, Access access, Body&& body) -> decltype(body()) {
+    const bool write = access == Access::write;
     using Result = decltype(body());
     auto fail = [&](const StoreError& e) {
       return Result(Fail(StoreError{fmt::format("{}: {}: {}", path_.string(), context, e.message)}));

@@ -153,16 +153,14 @@ CutReport CutJob::resume() {
   return stream_from(plan->restart_index, plan->preamble);
 }
 
-std::optional<std::uint64_t> CutJob::executed_blocks(bool fresh) {
+std::optional<std::uint64_t> CutJob::executed_blocks() {
   // Let one more report come in (the link's status period, the PLC's poll) so the count is
   // not older than the moment we care about.
-  if (fresh) {
-    const std::size_t before = link_.progress().statuses_received;
-    const auto deadline = Clock::now() + std::chrono::milliseconds(600);
-    while (Clock::now() < deadline && link_.progress().statuses_received < before + 2 && !cell_)
-      std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    if (cell_) std::this_thread::sleep_for(std::chrono::milliseconds(150));
-  }
+  const std::size_t before = link_.progress().statuses_received;
+  const auto deadline = Clock::now() + std::chrono::milliseconds(600);
+  while (Clock::now() < deadline && link_.progress().statuses_received < before + 2 && !cell_)
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  if (cell_) std::this_thread::sleep_for(std::chrono::milliseconds(150));
   if (const auto p = link_.progress(); p.last_status && p.last_status->executed_blocks) return p.last_status->executed_blocks;
   if (cell_) return cell_->status().cnc_executed_blocks;
   return std::nullopt;
@@ -208,7 +206,7 @@ CutReport CutJob::stream_span(std::size_t from, std::vector<std::string> preambl
   set_state(CutState::cutting);
   const auto started = Clock::now();
   // The machine stands still here (fresh, or recovered): its count is this attempt's base.
-  executed_base_ = executed_blocks(true);
+  executed_base_ = executed_blocks();
   preamble_lines_ = preamble.size();
   {
     std::lock_guard lock(mutex_);
@@ -331,7 +329,7 @@ void CutJob::stop_safely(LinkError why) {
   std::uint64_t executed_now = 0;
   bool have_executed = false;
   if (executed_base_) {
-    if (const auto e = executed_blocks(true)) {
+    if (const auto e = executed_blocks()) {
       executed_now = *e;
       have_executed = true;
     }

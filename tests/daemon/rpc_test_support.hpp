@@ -208,7 +208,7 @@ class ServerFixture : public ::testing::Test {
     const json& p = request.params;
     if (request.method == "echo") return p;
     if (request.method == "add") return p.at("a").get<int>() + p.at("b").get<int>();
-    if (request.method == "whoami") return json{{"client", client.id}, {"tcp", client.via_tcp}};
+    if (request.method == "whoami") return json{{"client", client.id}, {"tcp", client.via == lamina::daemon::Via::tcp}};
     if (request.method == "big") return std::string(p.at("bytes").get<std::size_t>(), 'x');
     if (request.method == "note") {
       ++notes_;

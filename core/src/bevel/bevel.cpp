@@ -554,7 +554,7 @@ std::expected<BevelPlan, Error> bevel_detail::plan_bevels_on(const Mesh& mesh, c
   std::optional<geometry_detail::TriangleTree> own_tree;
   const geometry_detail::TriangleTree* model = model_tree;
   if (params.measure_surface_distance && !layers.empty() && !model) {
-    own_tree.emplace(mesh.vertices, mesh.faces, params.parallel);
+    own_tree.emplace(mesh.vertices, mesh.faces, geometry_detail::threads_for(params.parallel));
     model = &*own_tree;
   }
   if (!params.measure_surface_distance) model = nullptr;

@@ -11,6 +11,7 @@
 namespace lamina::bevel_detail {
 using geometry_detail::build_stack_shells;
 using geometry_detail::StackShells;
+using geometry_detail::Threads;
 using geometry_detail::TriangleTree;
 using deviation_detail::max_distance;
 using deviation_detail::sample_region;
@@ -74,17 +75,17 @@ double layer_surface_distance(const TriangleTree& model, double model_z_lo_mm, d
   std::erase_if(walls, [&](const Eigen::Vector3d& p) {
     return p.z() > model_z_hi_mm + kOnFace || p.z() < model_z_lo_mm - kOnFace;
   });
-  sort_morton(walls, false);
-  const double stack_to_model = max_distance(model, walls, false).distance;
+  sort_morton(walls, Threads::one);
+  const double stack_to_model = max_distance(model, walls, Threads::one).distance;
 
   BevelPlan one;
   one.layers.push_back(layer);
   const StackShells shells = build_stack_shells(one);
   if (shells.faces.empty()) return stack_to_model;
-  const TriangleTree shell(shells.vertices, shells.faces, false);
+  const TriangleTree shell(shells.vertices, shells.faces, Threads::one);
   std::vector<Eigen::Vector3d> contours = contour_samples(sub_slices, ds_mm);
-  sort_morton(contours, false);
-  const double model_to_stack = max_distance(shell, contours, false).distance;
+  sort_morton(contours, Threads::one);
+  const double model_to_stack = max_distance(shell, contours, Threads::one).distance;
   return std::max(stack_to_model, model_to_stack);
 }
 

@@ -68,6 +68,17 @@ double jet_travel_s(const Eigen::Vector3d& top0, const Eigen::Vector3d& bottom0,
   return std::max((top1 - top0).norm(), (bottom1 - bottom0).norm()) / feed_mm_per_s;
 }
 
+// What a contour is (ToolContour::frees / closed): a whole freeing ring, a run of a trim pass
+// (where a multi-cut edge differs from the last pass), or a run between microjoints.
+struct ContourShape {
+  bool frees = false;
+  bool closed = false;
+};
+constexpr ContourShape kFreeingRing{.frees = true, .closed = true};
+constexpr ContourShape kTrimRun{.frees = false, .closed = false};
+// Whether the runs between microjoints are of the pass that frees the part.
+enum class Frees : bool { no, yes };
+
 class SheetBuilder {
  public:
   SheetBuilder(const BevelPlan& plan, std::span<const Part> parts, const NestedSheet& sheet, const Material& material,
@@ -197,7 +208,7 @@ class SheetBuilder {
       std::vector<double> bridges = tabs_u;
       if (bridges.empty())
         bridges.push_back(static_cast<double>(std::min_element(sliver.begin(), sliver.end()) - sliver.begin()));
-      return cut_between(passes[pi], bridges, gap, t, false);
+      return cut_between(passes[pi], bridges, gap, t, Frees::no);
     }
     std::size_t start = 0;
     while (differs[start]) ++start;  // a line that does not differ (count < n)
@@ -211,7 +222,7 @@ class SheetBuilder {
       while (k + len < n && differs[(start + k + len) % n]) ++len;
       std::vector<PathPoint> run;
       for (std::size_t j = 0; j < len + 2; ++j) run.push_back(passes[pi].points[(i + n - 1 + j) % n]);
-      emit_contour(std::move(run), passes[pi].points, t, false, false);
+      emit_contour(std::move(run), passes[pi].points, t, kTrimRun);
       k += len;
     }
     return {};
@@ -254,10 +265,10 @@ class SheetBuilder {
     if (tabs_u.empty()) {
       std::vector<PathPoint> ring = final_pass.points;
       ring.push_back(ring.front());
-      emit_contour(std::move(ring), final_pass.points, t, true, true);
+      emit_contour(std::move(ring), final_pass.points, t, kFreeingRing);
       return {};
     }
-    return cut_between(final_pass, tabs_u, gap, t, true);
+    return cut_between(final_pass, tabs_u, gap, t, Frees::yes);
   }
 
   // Trim runs separated by a short stretch of lines shared with the freeing pass are cut as one:
@@ -313,7 +324,7 @@ class SheetBuilder {
 
   // A closed pass cut as open runs between gaps centred at the station parameters `gaps_u`.
   std::expected<void, Error> cut_between(const CompensatedPass& pass, std::vector<double> gaps_u, double gap_mm,
-                                         const Target& t, bool frees) {
+                                         const Target& t, Frees frees) {
     if (gap_mm * static_cast<double>(gaps_u.size()) >= 0.9 * pass.length_mm)
       return std::unexpected(invalid(fmt::format(
           "sheet {}, part {}: {} microjoint(s) of {} mm (kerf included) do not fit an outline {:.3f} mm long",
@@ -327,8 +338,9 @@ class SheetBuilder {
       double s1 = centres[(j + 1) % k] - 0.5 * gap_mm;
       if (j + 1 == k) s1 += pass.length_mm;
       if (s1 - s0 < 1e-6) continue;
-      emit_contour(cam_detail::sub_path(pass, s0, s1), pass.points, t, frees, false);
-      if (frees) {
+      emit_contour(cam_detail::sub_path(pass, s0, s1), pass.points, t,
+                   ContourShape{.frees = frees == Frees::yes, .closed = false});
+      if (frees == Frees::yes) {
         // The uncut material: the gap minus the kerf on both sides.
         const double a = s1 + 0.5 * p_.kerf_mm, b = s1 + gap_mm - 0.5 * p_.kerf_mm;
         const auto piece = cam_detail::sub_path(pass, a, b);
@@ -362,7 +374,7 @@ class SheetBuilder {
     t.outline = -1;
     t.pass = 0;
     t.is_hole = true;
-    emit_contour(std::move(closed), ring, t, true, true);
+    emit_contour(std::move(closed), ring, t, kFreeingRing);
     return {};
   }
 
@@ -373,8 +385,9 @@ class SheetBuilder {
     return std::min(wanted, 0.5 * cam_detail::ray_to_ring(ring, p, dir));
   }
 
+  // The jet is on for every move but a rapid (the pierce opens it, the lead-out closes the cut).
   void push(MoveKind kind, const Eigen::Vector3d& tip, const Eigen::Vector3d& axis, double feed, double duration,
-            bool jet, int contour, double dwell = 0.0) {
+            int contour, double dwell = 0.0) {
     ToolMove m;
     m.kind = kind;
     m.tip_mm = tip;
@@ -382,19 +395,19 @@ class SheetBuilder {
     m.feed_mm_per_s = feed;
     m.duration_s = duration;
     m.dwell_s = dwell;
-    m.jet_on = jet;
+    m.jet_on = kind != MoveKind::rapid;
     m.contour = contour;
     out_.moves.push_back(m);
   }
 
   void rapid_to(const Eigen::Vector3d& tip, const Eigen::Vector3d& axis, int contour) {
     const Eigen::Vector3d from = out_.moves.empty() ? tip : out_.moves.back().tip_mm;
-    push(MoveKind::rapid, tip, axis, 0.0, (tip - from).norm() / p_.rapid_mm_per_s, false, contour);
+    push(MoveKind::rapid, tip, axis, 0.0, (tip - from).norm() / p_.rapid_mm_per_s, contour);
   }
 
   // One contour: rapid over the pierce point, down, pierce, lead-in, the cut, lead-out, up.
-  void emit_contour(std::vector<PathPoint> pts, const std::vector<PathPoint>& ring, const Target& t, bool frees,
-                    bool closed) {
+  void emit_contour(std::vector<PathPoint> pts, const std::vector<PathPoint>& ring, const Target& t,
+                    ContourShape shape) {
     const int id = static_cast<int>(out_.contours.size());
     ToolContour c;
     c.placement = t.placement;
@@ -403,8 +416,8 @@ class SheetBuilder {
     c.outline = t.outline;
     c.pass = t.pass;
     c.is_hole = t.is_hole;
-    c.frees = frees;
-    c.closed = closed;
+    c.frees = shape.frees;
+    c.closed = shape.closed;
     c.first_move = out_.moves.size();
     const PathPoint& first = pts.front();
     const PathPoint& end = pts.back();
@@ -421,18 +434,17 @@ class SheetBuilder {
     c.pierce_mm = pierce2;
     rapid_to({pierce.x(), pierce.y(), p_.safe_z_mm}, Eigen::Vector3d::UnitZ(), id);
     rapid_to(pierce, Eigen::Vector3d::UnitZ(), id);
-    push(MoveKind::pierce, pierce, Eigen::Vector3d::UnitZ(), 0.0, p_.pierce_dwell_s, true, id, p_.pierce_dwell_s);
+    push(MoveKind::pierce, pierce, Eigen::Vector3d::UnitZ(), 0.0, p_.pierce_dwell_s, id, p_.pierce_dwell_s);
     // Lead-in: the head turns from vertical (the pierce) to the first line's axis on the way.
     const double f_in = first.feed_mm_per_s * first.corner_factor;
-    push(MoveKind::lead_in, first.tip, first.axis, f_in, jet_travel_s(pierce, pierce - down, first.tip, first.bottom, f_in),
-         true, id);
+    push(MoveKind::lead_in, first.tip, first.axis, f_in, jet_travel_s(pierce, pierce - down, first.tip, first.bottom, f_in), id);
     for (std::size_t k = 1; k < pts.size(); ++k) {
       const PathPoint& a = pts[k - 1];
       const PathPoint& b = pts[k];
       const double f = std::min(a.feed_mm_per_s, b.feed_mm_per_s) * std::min(a.corner_factor, b.corner_factor);
       const double dur = jet_travel_s(a.tip, a.bottom, b.tip, b.bottom, f);
       if (dur <= 0.0) continue;  // a repeated line
-      push(MoveKind::cut, b.tip, b.axis, f, dur, true, id);
+      push(MoveKind::cut, b.tip, b.axis, f, dur, id);
     }
     const double lead_out = fit_lead(p_.lead_out_mm, ring, end.tip.head<2>(), end.scrap);
     const Eigen::Vector2d out2 = end.tip.head<2>() + lead_out * end.scrap;
@@ -440,7 +452,7 @@ class SheetBuilder {
     const Eigen::Vector3d out_bottom = out - (t_mm / end.axis.z()) * end.axis;
     const double f_out = end.feed_mm_per_s * end.corner_factor;
     if (lead_out > 0.0)
-      push(MoveKind::lead_out, out, end.axis, f_out, jet_travel_s(end.tip, end.bottom, out, out_bottom, f_out), true, id);
+      push(MoveKind::lead_out, out, end.axis, f_out, jet_travel_s(end.tip, end.bottom, out, out_bottom, f_out), id);
     rapid_to({out.x(), out.y(), p_.safe_z_mm}, end.axis, id);
     c.end_move = out_.moves.size();
     out_.contours.push_back(c);

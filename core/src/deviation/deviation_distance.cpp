@@ -31,6 +31,7 @@ using geometry_detail::sort_morton;
 using geometry_detail::StackShells;
 using geometry_detail::station_lines;
 using geometry_detail::station_offset;
+using geometry_detail::threads_for;
 using geometry_detail::to_clipper;
 
 // Samples of a horizontal region (Clipper paths, positive fill) at height z: its vertices, its
@@ -196,14 +197,14 @@ bool in_region(const ClipperLib::Paths& region, const Eigen::Vector2d& p) {
 // a maximum between its points (issue 17, item 8: a nosecone's top face read 0.500 mm where
 // 0.528 was true, off the axis).
 FarthestPoint farthest_on_faces(const TriangleTree& model, const std::vector<FaceRegion>& faces, double ds,
-                                bool parallel) {
+                                Threads threads) {
   constexpr double kRegionBudget = 250000.0;
   std::vector<FarthestPoint> best(faces.size());
   auto one = [&](std::size_t f) {
     std::vector<Eigen::Vector3d> samples;
     sample_region(faces[f].region, faces[f].z, ds, kRegionBudget, samples);
-    sort_morton(samples, false);
-    FarthestPoint b = max_distance(model, samples, false);
+    sort_morton(samples, Threads::one);
+    FarthestPoint b = max_distance(model, samples, Threads::one);
     if (b.distance <= 0.0) return;
     for (double step = ds / 8; step >= ds / 64; step /= 8) {
       samples.clear();
@@ -212,12 +213,12 @@ FarthestPoint farthest_on_faces(const TriangleTree& model, const std::vector<Fac
           const Eigen::Vector2d p(b.at.x() + i * step, b.at.y() + j * step);
           if (in_region(faces[f].region, p)) samples.emplace_back(p.x(), p.y(), faces[f].z);
         }
-      const FarthestPoint finer = max_distance(model, samples, false);
+      const FarthestPoint finer = max_distance(model, samples, Threads::one);
       if (finer.distance > b.distance) b = finer;
     }
     best[f] = b;
   };
-  if (parallel)
+  if (threads == Threads::many)
     tbb::parallel_for(std::size_t{0}, faces.size(), one);
   else
     for (std::size_t f = 0; f < faces.size(); ++f) one(f);
@@ -230,7 +231,7 @@ FarthestPoint farthest_on_faces(const TriangleTree& model, const std::vector<Fac
 }  // namespace
 
 // The sample farthest from the tree (the first of equals, in sample order).
-FarthestPoint max_distance(const TriangleTree& tree, const std::vector<Eigen::Vector3d>& samples, bool parallel) {
+FarthestPoint max_distance(const TriangleTree& tree, const std::vector<Eigen::Vector3d>& samples, Threads threads) {
   const std::size_t count = samples.size();
   if (count == 0 || tree.empty()) return {};
   constexpr std::size_t kBlock = 4096;
@@ -255,7 +256,7 @@ FarthestPoint max_distance(const TriangleTree& tree, const std::vector<Eigen::Ve
     }
     block_max[b] = local;
   };
-  if (parallel)
+  if (threads == Threads::many)
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, blocks), [&](const tbb::blocked_range<std::size_t>& r) {
       for (std::size_t b = r.begin(); b != r.end(); ++b) run(b);
     });
@@ -270,10 +271,11 @@ FarthestPoint max_distance(const TriangleTree& tree, const std::vector<Eigen::Ve
 FarthestPoint max_surface_distance(const Mesh& mesh, const BevelPlan& plan, const DeviationParams& params) {
   std::vector<FaceRegion> faces;
   std::vector<Eigen::Vector3d> samples = stack_samples(plan, params.distance_sample_mm, faces);
-  sort_morton(samples, params.parallel);
-  const TriangleTree model(mesh.vertices, mesh.faces, params.parallel);
-  FarthestPoint stack_to_model = max_distance(model, samples, params.parallel);
-  const FarthestPoint on_faces = farthest_on_faces(model, faces, params.distance_sample_mm, params.parallel);
+  const Threads threads = threads_for(params.parallel);
+  sort_morton(samples, threads);
+  const TriangleTree model(mesh.vertices, mesh.faces, threads);
+  FarthestPoint stack_to_model = max_distance(model, samples, threads);
+  const FarthestPoint on_faces = farthest_on_faces(model, faces, params.distance_sample_mm, threads);
   if (on_faces.distance > stack_to_model.distance) stack_to_model = on_faces;
 
   samples = mesh.vertices;
@@ -282,10 +284,10 @@ FarthestPoint max_surface_distance(const Mesh& mesh, const BevelPlan& plan, cons
     samples.push_back((mesh.vertices[static_cast<std::size_t>(f[0])] + mesh.vertices[static_cast<std::size_t>(f[1])] +
                        mesh.vertices[static_cast<std::size_t>(f[2])]) /
                       3.0);
-  sort_morton(samples, params.parallel);
+  sort_morton(samples, threads);
   const StackShells shells = build_stack_shells(plan);
-  const TriangleTree stack(shells.vertices, shells.faces, params.parallel);
-  const FarthestPoint model_to_stack = max_distance(stack, samples, params.parallel);
+  const TriangleTree stack(shells.vertices, shells.faces, threads);
+  const FarthestPoint model_to_stack = max_distance(stack, samples, threads);
   return model_to_stack.distance > stack_to_model.distance ? model_to_stack : stack_to_model;
 }
 

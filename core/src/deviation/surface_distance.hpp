@@ -10,6 +10,7 @@
 #include "geometry/stack_geometry.hpp"
 
 namespace lamina::deviation_detail {
+using geometry_detail::Threads;
 using geometry_detail::TriangleTree;
 
 // The largest distance between the stack's surface and the model's (both ways), estimated on
@@ -35,6 +36,6 @@ void sample_region(const ClipperLib::Paths& region, double z, double spacing, do
                    std::vector<Eigen::Vector3d>& out);
 
 // The sample farthest from the tree's triangles (the first of equals, in sample order).
-FarthestPoint max_distance(const TriangleTree& tree, const std::vector<Eigen::Vector3d>& samples, bool parallel);
+FarthestPoint max_distance(const TriangleTree& tree, const std::vector<Eigen::Vector3d>& samples, Threads threads);
 
 }  // namespace lamina::deviation_detail

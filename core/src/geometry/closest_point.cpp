@@ -58,8 +58,8 @@ std::vector<std::pair<std::uint64_t, std::uint32_t>> morton_keys(const std::vect
   return keys;
 }
 
-void sort_keys(std::vector<std::pair<std::uint64_t, std::uint32_t>>& keys, bool parallel) {
-  if (parallel)
+void sort_keys(std::vector<std::pair<std::uint64_t, std::uint32_t>>& keys, Threads threads) {
+  if (threads == Threads::many)
     tbb::parallel_sort(keys.begin(), keys.end());
   else
     std::sort(keys.begin(), keys.end());
@@ -112,7 +112,7 @@ double point_triangle_distance2(const Eigen::Vector3d& p, const Eigen::Vector3d&
 }
 
 TriangleTree::TriangleTree(const std::vector<Eigen::Vector3d>& vertices,
-                           const std::vector<std::array<std::int32_t, 3>>& faces, bool parallel) {
+                           const std::vector<std::array<std::int32_t, 3>>& faces, Threads threads) {
   const std::size_t n = faces.size();
   if (n == 0) return;
   // Triangles in Morton order of their centroids (21 bits per axis over the centroids' box); the
@@ -125,7 +125,7 @@ TriangleTree::TriangleTree(const std::vector<Eigen::Vector3d>& vertices,
                    vertices[static_cast<std::size_t>(faces[f][2])]) /
                   3.0;
   auto keys = morton_keys(centroid);
-  sort_keys(keys, parallel);
+  sort_keys(keys, threads);
 
   tris_.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
@@ -153,7 +153,7 @@ TriangleTree::TriangleTree(const std::vector<Eigen::Vector3d>& vertices,
     const std::size_t mid = begin + m / 2;
     const std::size_t left = node + 1;
     const std::size_t right = left + subtree_nodes(m / 2, memo);
-    if (parallel && m > 50000) {
+    if (threads == Threads::many && m > 50000) {
       tbb::parallel_invoke([&] { self(self, left, begin, mid); }, [&] { self(self, right, mid, end); });
     } else {
       self(self, left, begin, mid);
@@ -169,9 +169,9 @@ TriangleTree::TriangleTree(const std::vector<Eigen::Vector3d>& vertices,
   build(build, 0, 0, n);
 }
 
-void sort_morton(std::vector<Eigen::Vector3d>& points, bool parallel) {
+void sort_morton(std::vector<Eigen::Vector3d>& points, Threads threads) {
   auto keys = morton_keys(points);
-  sort_keys(keys, parallel);
+  sort_keys(keys, threads);
   std::vector<Eigen::Vector3d> sorted(points.size());
   for (std::size_t i = 0; i < keys.size(); ++i) sorted[i] = points[keys[i].second];
   points = std::move(sorted);

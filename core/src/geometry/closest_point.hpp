@@ -17,12 +17,16 @@ double point_triangle_distance2(const Eigen::Vector3d& p, const Eigen::Vector3d&
 // Reorders points along a Morton (Z-order) curve over their bounding box, so that consecutive
 // points are near each other (queries in that order find a near triangle at once). Ties keep
 // their order: the result does not depend on threads.
-void sort_morton(std::vector<Eigen::Vector3d>& points, bool parallel);
+// How a step may use threads (TBB); results never depend on it.
+enum class Threads : bool { one, many };
+inline Threads threads_for(bool parallel) { return parallel ? Threads::many : Threads::one; }
+
+void sort_morton(std::vector<Eigen::Vector3d>& points, Threads threads);
 
 class TriangleTree {
  public:
   TriangleTree(const std::vector<Eigen::Vector3d>& vertices, const std::vector<std::array<std::int32_t, 3>>& faces,
-               bool parallel);
+               Threads threads);
 
   bool empty() const { return tris_.empty(); }
 

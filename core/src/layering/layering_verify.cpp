@@ -108,7 +108,7 @@ std::expected<LayerChoice, Error> layer_verified(Estimator& est, const Mesh& mes
     if (choice.layers.empty() || choice.state_limit) break;
     const std::vector<Candidate> todo = unmeasured(est, choice);
     if (todo.empty()) break;  // every chosen layer stands on its measure
-    if (!model) model.emplace(mesh.vertices, mesh.faces, params.parallel);
+    if (!model) model.emplace(mesh.vertices, mesh.faces, geometry_detail::threads_for(params.parallel));
     auto fresh = measure(est, mesh, *model, params, todo, plans);
     if (!fresh) return std::unexpected(fresh.error());
     if (params.on_round) params.on_round(round + 1, kMaxRounds);

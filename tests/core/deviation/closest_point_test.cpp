@@ -61,8 +61,8 @@ TEST(TriangleTreeTest, AgreesWithBruteForce) {
     for (int k = 0; k < 3; ++k) vertices.push_back(c + Eigen::Vector3d(small(rng), small(rng), small(rng)));
     faces.push_back({base, base + 1, base + 2});
   }
-  for (const bool parallel : {false, true}) {
-    const TriangleTree tree(vertices, faces, parallel);
+  for (const auto threads : {geometry_detail::Threads::one, geometry_detail::Threads::many}) {
+    const TriangleTree tree(vertices, faces, threads);
     std::int32_t hint = -1;
     for (int q = 0; q < 500; ++q) {
       const Eigen::Vector3d p(u(rng) * 1.2 - 5, u(rng) * 1.2 - 5, 0.5 * u(rng) - 5);
@@ -89,7 +89,7 @@ TEST(TriangleTreeTest, MortonOrderKeepsThePoints) {
   std::vector<Eigen::Vector3d> pts;
   for (int i = 0; i < 1000; ++i) pts.emplace_back(u(rng), u(rng), u(rng));
   auto sorted = pts;
-  geometry_detail::sort_morton(sorted, true);
+  geometry_detail::sort_morton(sorted, geometry_detail::Threads::many);
   auto key = [](const Eigen::Vector3d& v) { return std::tuple(v.x(), v.y(), v.z()); };
   auto a = pts, b = sorted;
   std::sort(a.begin(), a.end(), [&](auto& x, auto& y) { return key(x) < key(y); });

@@ -47,9 +47,13 @@ struct RpcRequest {
   nlohmann::json params;   // object or array; an absent params is an empty object
 };
 
+// The listener a client came through: its limits (max_clients each) and, for TCP, the token.
+enum class Via : std::uint8_t { unix_socket, tcp };
+const char* via_name(Via via);  // "Unix", "TCP" (log lines)
+
 struct ClientContext {
   std::uint64_t id = 0;
-  bool via_tcp = false;
+  Via via = Via::unix_socket;
   bool subscribed = false;  // set by a handler (server.subscribe): receives broadcast()s
 };
 

@@ -107,8 +107,9 @@ class CutJob {
   LinkCallbacks span_callbacks(std::shared_ptr<detail::LatestRelay<CutReport>> relay);
   std::optional<LinkError> wait_until_run_out();
   bool refuse_unsendable();
-  // Blocks the CNC has finished, from the link's status or the PLC's (nullopt: neither says).
-  std::optional<std::uint64_t> executed_blocks(bool fresh);
+  // Blocks the CNC has finished, from the link's status or the PLC's (nullopt: neither says),
+  // after one more report came in.
+  std::optional<std::uint64_t> executed_blocks();
   void stop_safely(LinkError why);
   std::optional<LinkError> jet_off_without_plc(bool axes_still);
   std::function<void(const CellFaultReport&)> fault_handler();
