@@ -108,34 +108,19 @@ ClipperLib::Paths facet_shadows(const Mesh& mesh, const std::vector<double>& zs,
 class SlabFacets {
  public:
   SlabFacets(const Mesh& mesh, double zb, double zt, double cell_mm) : mesh_(mesh), zb_(zb), zt_(zt) {
-    Eigen::Vector2d lo(std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()), hi = -lo;
+    std::vector<Box2> footprints;
     for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
       const auto [a, b, c] = corners(f);
       const double zl = std::min({a.z(), b.z(), c.z()}), zh = std::max({a.z(), b.z(), c.z()});
       if (zh < zb || zl > zt) continue;
       facets_.push_back(static_cast<std::uint32_t>(f));
-      lo = lo.cwiseMin(a.head<2>()).cwiseMin(b.head<2>()).cwiseMin(c.head<2>());
-      hi = hi.cwiseMax(a.head<2>()).cwiseMax(b.head<2>()).cwiseMax(c.head<2>());
+      footprints.push_back({a.head<2>().cwiseMin(b.head<2>()).cwiseMin(c.head<2>()),
+                            a.head<2>().cwiseMax(b.head<2>()).cwiseMax(c.head<2>())});
     }
-    if (facets_.empty()) return;
-    origin_ = lo;
-    const Eigen::Vector2d size = (hi - lo).cwiseMax(1e-9);
-    cell_ = std::max({cell_mm, std::sqrt(size.x() * size.y() / static_cast<double>(facets_.size())), std::max(size.x(), size.y()) / 2048.0});
-    nx_ = std::max(1, static_cast<int>(std::ceil(size.x() / cell_)));
-    ny_ = std::max(1, static_cast<int>(std::ceil(size.y() / cell_)));
-    begin_.assign(static_cast<std::size_t>(nx_) * ny_ + 1, 0);
-    auto each_cell = [&](std::uint32_t f, auto&& fn) {
-      const auto [a, b, c] = corners(f);
-      const Eigen::Vector2d l = (a.head<2>().cwiseMin(b.head<2>()).cwiseMin(c.head<2>()) - origin_) / cell_;
-      const Eigen::Vector2d h = (a.head<2>().cwiseMax(b.head<2>()).cwiseMax(c.head<2>()) - origin_) / cell_;
-      for (int y = clampi(l.y(), ny_); y <= clampi(h.y(), ny_); ++y)
-        for (int x = clampi(l.x(), nx_); x <= clampi(h.x(), nx_); ++x) fn(static_cast<std::size_t>(y) * nx_ + x);
-    };
-    for (std::uint32_t f : facets_) each_cell(f, [&](std::size_t c) { ++begin_[c + 1]; });
-    for (std::size_t c = 0; c + 1 < begin_.size(); ++c) begin_[c + 1] += begin_[c];
-    items_.resize(begin_.back());
-    std::vector<std::uint32_t> fill(begin_.begin(), begin_.end() - 1);
-    for (std::uint32_t i = 0; i < facets_.size(); ++i) each_cell(facets_[i], [&](std::size_t c) { items_[fill[c]++] = i; });
+    grid_ = BoxGrid(footprints, [&](const Eigen::Vector2d& size, std::size_t count) {
+      return std::max({cell_mm, std::sqrt(size.x() * size.y() / static_cast<double>(count)),
+                       std::max(size.x(), size.y()) / 2048.0});
+    });
     stamp_.assign(facets_.size(), 0u);
   }
 
@@ -148,18 +133,19 @@ class SlabFacets {
     if (facets_.empty()) return;
     const Eigen::Vector2d t(-n.y(), n.x());
     const double len = u_max - u_min;
-    const int steps = std::max(1, static_cast<int>(std::ceil(len / (0.5 * cell_))));
+    const double cell_mm = grid_.cell_mm();
+    const int steps = std::max(1, static_cast<int>(std::ceil(len / (0.5 * cell_mm))));
     // The cells the line passes (and their neighbours: it may cut a corner between two
     // samples), each once; then their facets, each once (stamped).
     cells_.clear();
     for (int k = 0; k <= steps; ++k) {
-      const Eigen::Vector2d p = (base + (u_min + len * k / steps) * n - origin_) / cell_;
+      const Eigen::Vector2d p = (base + (u_min + len * k / steps) * n - grid_.origin()) / cell_mm;
       const int cx = static_cast<int>(std::floor(p.x())), cy = static_cast<int>(std::floor(p.y()));
       for (int dy = -1; dy <= 1; ++dy) {
         for (int dx = -1; dx <= 1; ++dx) {
           const int x = cx + dx, y = cy + dy;
-          if (x < 0 || y < 0 || x >= nx_ || y >= ny_) continue;
-          cells_.push_back(static_cast<std::uint32_t>(y * nx_ + x));
+          if (x < 0 || y < 0 || x >= grid_.nx() || y >= grid_.ny()) continue;
+          cells_.push_back(static_cast<std::uint32_t>(grid_.cell(x, y)));
         }
       }
     }
@@ -170,8 +156,7 @@ class SlabFacets {
       generation_ = 1;
     }
     for (std::uint32_t c : cells_) {
-      for (std::uint32_t i = begin_[c]; i < begin_[c + 1]; ++i) {
-        const std::uint32_t local = items_[i];
+      for (const std::uint32_t local : grid_.items(c)) {
         if (stamp_[local] == generation_) continue;
         stamp_[local] = generation_;
         seen.push_back(facets_[local]);
@@ -197,8 +182,6 @@ class SlabFacets {
   }
 
  private:
-  static int clampi(double v, int n) { return std::clamp(static_cast<int>(std::floor(v)), 0, n - 1); }
-
   std::array<Eigen::Vector3d, 3> corners(std::size_t f) const {
     const auto& tri = mesh_.faces[f];
     return {mesh_.vertices[static_cast<std::size_t>(tri[0])], mesh_.vertices[static_cast<std::size_t>(tri[1])],
@@ -224,10 +207,7 @@ class SlabFacets {
   const Mesh& mesh_;
   double zb_, zt_;
   std::vector<std::uint32_t> facets_;
-  Eigen::Vector2d origin_{0, 0};
-  double cell_ = 1.0;
-  int nx_ = 0, ny_ = 0;
-  std::vector<std::uint32_t> begin_, items_;  // CSR: cell → index into facets_
+  BoxGrid grid_;  // cell → index into facets_ (the footprints', in the same order)
   // Per-query scratch: one SlabFacets serves one layer on one thread.
   mutable std::vector<std::uint32_t> stamp_, cells_;
   mutable std::uint32_t generation_ = 0;

@@ -50,40 +50,15 @@ SectionLines::SectionLines(const Mesh& mesh, const Slice& slice) : z_mm_(slice.z
     }
   }
   if (segments_.empty()) return;
+  std::vector<Box2> boxes;
+  boxes.reserve(segments_.size());
+  for (const auto& s : segments_) boxes.push_back({s.a.cwiseMin(s.b), s.a.cwiseMax(s.b)});
   // About one segment per cell on average: contours are long thin sets, so use the extent.
-  const Eigen::Vector2d size = (hi - lo).cwiseMax(1e-9);
-  const double cells_wanted = std::max<double>(1.0, static_cast<double>(segments_.size()));
-  cell_mm_ = std::max(std::sqrt(size.x() * size.y() / cells_wanted), std::max(size.x(), size.y()) / 4096.0);
-  cell_mm_ = std::max(cell_mm_, 1e-6);
-  nx_ = std::max(1, static_cast<int>(std::ceil(size.x() / cell_mm_)));
-  ny_ = std::max(1, static_cast<int>(std::ceil(size.y() / cell_mm_)));
-  origin_ = lo;
-
-  auto cell_range = [&](const Segment& s, int& x0, int& x1, int& y0, int& y1) {
-    const Eigen::Vector2d a = (s.a.cwiseMin(s.b) - origin_) / cell_mm_;
-    const Eigen::Vector2d b = (s.a.cwiseMax(s.b) - origin_) / cell_mm_;
-    x0 = std::clamp(static_cast<int>(std::floor(a.x())), 0, nx_ - 1);
-    x1 = std::clamp(static_cast<int>(std::floor(b.x())), 0, nx_ - 1);
-    y0 = std::clamp(static_cast<int>(std::floor(a.y())), 0, ny_ - 1);
-    y1 = std::clamp(static_cast<int>(std::floor(b.y())), 0, ny_ - 1);
-  };
-  const std::size_t cells = static_cast<std::size_t>(nx_) * static_cast<std::size_t>(ny_);
-  cell_begin_.assign(cells + 1, 0);
-  for (const auto& s : segments_) {
-    int x0, x1, y0, y1;
-    cell_range(s, x0, x1, y0, y1);
-    for (int y = y0; y <= y1; ++y)
-      for (int x = x0; x <= x1; ++x) ++cell_begin_[static_cast<std::size_t>(y) * nx_ + x + 1];
-  }
-  for (std::size_t c = 0; c < cells; ++c) cell_begin_[c + 1] += cell_begin_[c];
-  cell_items_.resize(cell_begin_.back());
-  std::vector<std::uint32_t> fill(cell_begin_.begin(), cell_begin_.end() - 1);
-  for (std::uint32_t i = 0; i < segments_.size(); ++i) {
-    int x0, x1, y0, y1;
-    cell_range(segments_[i], x0, x1, y0, y1);
-    for (int y = y0; y <= y1; ++y)
-      for (int x = x0; x <= x1; ++x) cell_items_[fill[static_cast<std::size_t>(y) * nx_ + x]++] = i;
-  }
+  grid_ = BoxGrid(boxes, [](const Eigen::Vector2d& size, std::size_t count) {
+    const double cells_wanted = std::max<double>(1.0, static_cast<double>(count));
+    const double cell = std::max(std::sqrt(size.x() * size.y() / cells_wanted), std::max(size.x(), size.y()) / 4096.0);
+    return std::max(cell, 1e-6);
+  });
 }
 
 std::optional<LineCrossing> SectionLines::exit_crossing(const Eigen::Vector2d& origin, const Eigen::Vector2d& direction,
@@ -91,8 +66,11 @@ std::optional<LineCrossing> SectionLines::exit_crossing(const Eigen::Vector2d& o
   if (segments_.empty() || !(u_max >= u_min)) return std::nullopt;
   // Clip the query to the grid's box (slab test), then walk its cells (Amanatides & Woo).
   double t0 = u_min, t1 = u_max;
-  const Eigen::Vector2d box_lo = origin_;
-  const Eigen::Vector2d box_hi = origin_ + Eigen::Vector2d(nx_, ny_) * cell_mm_;
+  const Eigen::Vector2d& grid_origin = grid_.origin();
+  const double cell_mm = grid_.cell_mm();
+  const int nx = grid_.nx(), ny = grid_.ny();
+  const Eigen::Vector2d box_lo = grid_origin;
+  const Eigen::Vector2d box_hi = grid_origin + Eigen::Vector2d(nx, ny) * cell_mm;
   for (int k = 0; k < 2; ++k) {
     if (std::abs(direction[k]) < 1e-300) {
       if (origin[k] < box_lo[k] || origin[k] > box_hi[k]) return std::nullopt;
@@ -106,17 +84,17 @@ std::optional<LineCrossing> SectionLines::exit_crossing(const Eigen::Vector2d& o
   }
   if (t0 > t1) return std::nullopt;
 
-  const Eigen::Vector2d start = (origin + t0 * direction - origin_) / cell_mm_;
-  int cx = std::clamp(static_cast<int>(std::floor(start.x())), 0, nx_ - 1);
-  int cy = std::clamp(static_cast<int>(std::floor(start.y())), 0, ny_ - 1);
+  const Eigen::Vector2d start = origin + t0 * direction;
+  int cx = grid_.column(start.x());
+  int cy = grid_.row(start.y());
   const int step_x = direction.x() > 0 ? 1 : -1;
   const int step_y = direction.y() > 0 ? 1 : -1;
   const double inf = std::numeric_limits<double>::infinity();
-  const double dt_x = std::abs(direction.x()) > 1e-300 ? cell_mm_ / std::abs(direction.x()) : inf;
-  const double dt_y = std::abs(direction.y()) > 1e-300 ? cell_mm_ / std::abs(direction.y()) : inf;
+  const double dt_x = std::abs(direction.x()) > 1e-300 ? cell_mm / std::abs(direction.x()) : inf;
+  const double dt_y = std::abs(direction.y()) > 1e-300 ? cell_mm / std::abs(direction.y()) : inf;
   auto boundary_t = [&](int c, int step, int k) {
     if (std::abs(direction[k]) < 1e-300) return inf;
-    const double edge = origin_[k] + (c + (step > 0 ? 1 : 0)) * cell_mm_;
+    const double edge = grid_origin[k] + (c + (step > 0 ? 1 : 0)) * cell_mm;
     return (edge - origin[k]) / direction[k];
   };
   double next_x = boundary_t(cx, step_x, 0);
@@ -149,19 +127,18 @@ std::optional<LineCrossing> SectionLines::exit_crossing(const Eigen::Vector2d& o
     }
   };
   while (true) {
-    const std::size_t c = static_cast<std::size_t>(cy) * nx_ + cx;
-    for (std::uint32_t k = cell_begin_[c]; k < cell_begin_[c + 1]; ++k) consider(cell_items_[k]);
+    for (const std::uint32_t idx : grid_.items(grid_.cell(cx, cy))) consider(idx);
     if (seen_count >= 64) seen_count = 0;  // long walks: forget old ones (re-testing is harmless)
     const double t_exit = std::min(next_x, next_y);
     if (t_exit > t1) break;
     if (next_x < next_y) {
       cx += step_x;
       next_x += dt_x;
-      if (cx < 0 || cx >= nx_) break;
+      if (cx < 0 || cx >= nx) break;
     } else {
       cy += step_y;
       next_y += dt_y;
-      if (cy < 0 || cy >= ny_) break;
+      if (cy < 0 || cy >= ny) break;
     }
   }
   return best;
@@ -169,21 +146,20 @@ std::optional<LineCrossing> SectionLines::exit_crossing(const Eigen::Vector2d& o
 
 bool SectionLines::contains(const Eigen::Vector2d& p) const {
   if (segments_.empty()) return false;
-  const Eigen::Vector2d g = (p - origin_) / cell_mm_;
+  const Eigen::Vector2d g = (p - grid_.origin()) / grid_.cell_mm();
+  const int nx = grid_.nx();
   const int cy = static_cast<int>(std::floor(g.y()));
-  if (cy < 0 || cy >= ny_ || g.x() >= nx_ || g.x() < 0) return false;
+  if (cy < 0 || cy >= grid_.ny() || g.x() >= nx || g.x() < 0) return false;
   const int cx0 = static_cast<int>(std::floor(g.x()));
   // Count crossings of a horizontal ray from p towards the nearer side of the grid, each
   // segment once (it may sit in several cells of the row).
-  const bool right = cx0 >= nx_ / 2;
+  const bool right = cx0 >= nx / 2;
   std::uint32_t hits[128];
   int count = 0;
   std::vector<std::uint32_t> overflow;
-  const int from = right ? cx0 : 0, to = right ? nx_ : cx0 + 1;
+  const int from = right ? cx0 : 0, to = right ? nx : cx0 + 1;
   for (int cx = from; cx < to; ++cx) {
-    const std::size_t c = static_cast<std::size_t>(cy) * nx_ + cx;
-    for (std::uint32_t k = cell_begin_[c]; k < cell_begin_[c + 1]; ++k) {
-      const std::uint32_t idx = cell_items_[k];
+    for (const std::uint32_t idx : grid_.items(grid_.cell(cx, cy))) {
       const Segment& s = segments_[idx];
       if ((s.a.y() > p.y()) == (s.b.y() > p.y())) continue;
       const double x = s.a.x() + (p.y() - s.a.y()) * (s.b.x() - s.a.x()) / (s.b.y() - s.a.y());

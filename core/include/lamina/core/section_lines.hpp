@@ -2,6 +2,7 @@
 // Line queries against one slice: where does a horizontal line cross the section's boundary?
 // Used to find the corresponding points of a station on every sub-slice of a layer (paper 3-4:
 // "a line parallel to the projected vector … intersected with a short list of line segments").
+#include "lamina/core/box_grid.hpp"
 #include "lamina/core/mesh.hpp"
 #include "lamina/core/slice.hpp"
 
@@ -53,11 +54,7 @@ class SectionLines {
   };
   double z_mm_ = 0.0;
   std::vector<Segment> segments_;
-  Eigen::Vector2d origin_{0, 0};
-  double cell_mm_ = 1.0;
-  int nx_ = 0, ny_ = 0;
-  std::vector<std::uint32_t> cell_begin_;  // CSR: cell → segment indices
-  std::vector<std::uint32_t> cell_items_;
+  BoxGrid grid_;  // cell → indices into segments_
 };
 
 // du/dz of a surface with unit normal `normal` in the vertical plane along the horizontal unit
