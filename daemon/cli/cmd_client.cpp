@@ -204,6 +204,19 @@ void print_or(const ClientOptions& o, const Json& result, const std::function<vo
     human(result);
 }
 
+// One request, its answer printed (print_or); a failed call was reported by call() and exits 1.
+void call_and_print(const ClientOptions& o, const std::string& method, const Json& params,
+                    const std::function<void(const Json&)>& human, int& exit_code) {
+  auto r = call(o, method, params);
+  if (!r) {
+    exit_code = 1;
+    return;
+  }
+  print_or(o, *r, human);
+}
+
+void print_dump(const Json& j) { fmt::print("{}\n", j.dump()); }
+
 // --set KEY=VALUE… as the settings object: numbers and booleans as JSON, anything else as text.
 std::expected<Json, std::string> settings_from(const std::vector<std::string>& sets) {
   Json settings = Json::object();
@@ -271,17 +284,12 @@ void add_jobs_command(CLI::App& app, const std::shared_ptr<ClientOptions>& o, in
   auto* cmd = app.add_subcommand("jobs", "list laminad's jobs");
   add_common(cmd, *o);
   cmd->callback([o, &exit_code] {
-    auto r = call(*o, "job.list");
-    if (!r) {
-      exit_code = 1;
-      return;
-    }
-    print_or(*o, *r, [](const Json& list) {
+    call_and_print(*o, "job.list", Json::object(), [](const Json& list) {
       for (const Json& j : list)
         fmt::print("{}  {:<13} {}  sheet {}/{}{}\n", j.value("id", "?"), j.value("state", "?"), j.value("name", ""),
                    j.value("current_sheet", 0), j.value("sheets", 0),
                    j.value("error", "").empty() ? "" : "  (" + j.value("error", "") + ")");
-    });
+    }, exit_code);
   });
 }
 
@@ -295,13 +303,8 @@ void add_job_commands(CLI::App& app, const std::shared_ptr<ClientOptions>& o, in
     cmd->add_option("job", *id, "job id");
     add_common(cmd, *o);
     cmd->callback([o, id, &exit_code] {
-      auto r = id->empty() ? call(*o, "machine.resume") : call(*o, "job.resume", {{"job", *id}});
-      if (!r) {
-        exit_code = 1;
-        return;
-      }
-      if (id->empty()) print_or(*o, *r, [](const Json& j) { fmt::print("{}\n", j.dump()); });
-      else print_or(*o, *r, [](const Json& j) { print_job(j); });
+      if (id->empty()) call_and_print(*o, "machine.resume", Json::object(), print_dump, exit_code);
+      else call_and_print(*o, "job.resume", {{"job", *id}}, print_job, exit_code);
     });
   }
   for (const auto& [name, method, help] : std::vector<std::tuple<std::string, std::string, std::string>>{
@@ -312,12 +315,7 @@ void add_job_commands(CLI::App& app, const std::shared_ptr<ClientOptions>& o, in
     cmd->add_option("job", *id, "job id")->required();
     add_common(cmd, *o);
     cmd->callback([o, id, method, &exit_code] {
-      auto r = call(*o, method, {{"job", *id}});
-      if (!r) {
-        exit_code = 1;
-        return;
-      }
-      print_or(*o, *r, [](const Json& j) { print_job(j); });
+      call_and_print(*o, method, {{"job", *id}}, print_job, exit_code);
     });
   }
   {
@@ -328,12 +326,7 @@ void add_job_commands(CLI::App& app, const std::shared_ptr<ClientOptions>& o, in
     cmd->add_option("sheet", *sheet, "sheet number")->required();
     add_common(cmd, *o);
     cmd->callback([o, id, sheet, &exit_code] {
-      auto r = call(*o, "job.confirm_sheet", {{"job", *id}, {"sheet", *sheet}});
-      if (!r) {
-        exit_code = 1;
-        return;
-      }
-      print_or(*o, *r, [](const Json& j) { print_job(j); });
+      call_and_print(*o, "job.confirm_sheet", {{"job", *id}, {"sheet", *sheet}}, print_job, exit_code);
     });
   }
 }
@@ -344,12 +337,8 @@ void add_machine_commands(CLI::App& app, const std::shared_ptr<ClientOptions>& o
     auto* cmd = app.add_subcommand("status", "the machine in one line: state, position, feed, line");
     add_common(cmd, *o);
     cmd->callback([o, &exit_code] {
-      auto r = call(*o, "machine.status");
-      if (!r) {
-        exit_code = 1;
-        return;
-      }
-      print_or(*o, *r, [](const Json& s) { fmt::print("{}\n", status_line(s)); });
+      call_and_print(*o, "machine.status", Json::object(), [](const Json& s) { fmt::print("{}\n", status_line(s)); },
+                     exit_code);
     });
   }
   for (const auto& [name, method, help] : std::vector<std::tuple<std::string, std::string, std::string>>{
@@ -359,12 +348,7 @@ void add_machine_commands(CLI::App& app, const std::shared_ptr<ClientOptions>& o
     auto* cmd = app.add_subcommand(name, help);
     add_common(cmd, *o);
     cmd->callback([o, method, &exit_code] {
-      auto r = call(*o, method);
-      if (!r) {
-        exit_code = 1;
-        return;
-      }
-      print_or(*o, *r, [](const Json& j) { fmt::print("{}\n", j.dump()); });
+      call_and_print(*o, method, Json::object(), print_dump, exit_code);
     });
   }
 }
