@@ -69,7 +69,7 @@ std::optional<LineCrossing> SectionLines::exit_crossing(const Eigen::Vector2d& o
   const Eigen::Vector2d& grid_origin = grid_.origin();
   const double cell_mm = grid_.cell_mm();
   const int nx = grid_.nx(), ny = grid_.ny();
-  const Eigen::Vector2d box_lo = grid_origin;
+  const Eigen::Vector2d& box_lo = grid_origin;
   const Eigen::Vector2d box_hi = grid_origin + Eigen::Vector2d(nx, ny) * cell_mm;
   for (int k = 0; k < 2; ++k) {
     if (std::abs(direction[k]) < 1e-300) {
@@ -85,8 +85,7 @@ std::optional<LineCrossing> SectionLines::exit_crossing(const Eigen::Vector2d& o
   if (t0 > t1) return std::nullopt;
 
   const Eigen::Vector2d start = origin + t0 * direction;
-  int cx = grid_.column(start.x());
-  int cy = grid_.row(start.y());
+  int cx = grid_.column(start.x()), cy = grid_.row(start.y());
   const int step_x = direction.x() > 0 ? 1 : -1;
   const int step_y = direction.y() > 0 ? 1 : -1;
   const double inf = std::numeric_limits<double>::infinity();
