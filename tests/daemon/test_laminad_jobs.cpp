@@ -229,11 +229,20 @@ TEST(LaminadJobs, AbortStopsSafelyAndJobResumeRestartsAtTheContour) {
       break;
     }
   ASSERT_LT(restart, lines.size()) << "no contour marker after the stop";
-  EXPECT_LE(restart, first_run_done) << "nothing after the stop was skipped";
-  std::size_t contour_of_stop = 0;
-  for (std::size_t k = 0; k <= std::min(first_run_done, lines.size() - 1); ++k)
-    if (lines[k].rfind("(CONTOUR ", 0) == 0) contour_of_stop = k;
-  EXPECT_EQ(restart, contour_of_stop) << "restart at the start of the contour being cut, not earlier";
+  // The resume point from the post's map of the program (report.json): the first contour whose
+  // last cutting line had not run restarts at its marker. A contour whose cutting had all run
+  // is not cut again, even when the stop came before its retract (those lines need not run:
+  // the resume's own preamble goes to safe Z first); no cutting line is skipped.
+  std::ifstream report_file(std::filesystem::path(job["artefacts"].get<std::string>()) / "report.json");
+  const Json report = Json::parse(report_file);
+  std::size_t unfinished = lines.size();
+  for (const auto& contour : report["sheets"][0]["contour_lines"])
+    if (contour["last_cut_line"].get<std::size_t>() > first_run_done) {
+      unfinished = contour["line"].get<std::size_t>() - 1;
+      break;
+    }
+  EXPECT_EQ(restart, unfinished) << "restart at the start of the contour being cut (first run: " << first_run_done
+                                 << " lines done)";
   EXPECT_EQ(log.back().line, lines.back());
 }
 
