@@ -17,6 +17,8 @@ state_dir = "$work/state"
 socket = "$work/lamina.sock"
 socket_group = ""
 $tcp_lines
+[http]
+listen = ""
 [link]
 protocol = "grbl"
 port = "$work/cnc"

@@ -19,6 +19,8 @@
 #include <spdlog/spdlog.h>
 
 #include "api_methods.hpp"
+#include "http/http_server.hpp"
+#include "http/job_artefacts.hpp"
 #include "job_manager.hpp"
 #include "lamina/daemon/daemon_config.hpp"
 #include "lamina/daemon/job_store.hpp"
@@ -136,9 +138,29 @@ bool start_listening(RpcServer& server, const std::vector<int>& activated, const
   return true;
 }
 
+// [http] listen set: the web console's server, listening (nullptr and the error logged if it
+// cannot; nullptr without a word when [http] is off).
+std::unique_ptr<http::HttpServer> start_web(boost::asio::io_context& io, const HttpConfig& c, const JobManager& jobs) {
+  if (!c.host) return nullptr;
+  http::HttpSettings s;
+  s.host = *c.host == "localhost" ? "127.0.0.1" : *c.host;
+  s.port = c.port;
+  s.static_dir = c.static_dir;
+  s.idle_timeout_s = c.idle_timeout_s;
+  s.max_connections = c.max_connections;
+  auto web = std::make_unique<http::HttpServer>(io, s, http::job_artefacts(jobs));
+  if (auto r = web->listen(); !r) {
+    spdlog::error("{}", r.error());
+    return nullptr;
+  }
+  spdlog::info("web console: http://{}:{}/ (files from {})", s.host, web->port(), s.static_dir.string());
+  return web;
+}
+
 // Runs the io_context: the machine's status to subscribers, systemd's status and watchdog; a
 // SIGTERM or SIGINT winds the jobs down off the io thread, which keeps pinging the watchdog.
-void serve(boost::asio::io_context& io, boost::asio::signal_set& signals, RpcServer& server, JobManager& jobs) {
+void serve(boost::asio::io_context& io, boost::asio::signal_set& signals, RpcServer& server, http::HttpServer* web,
+           JobManager& jobs) {
   boost::asio::steady_timer status_timer(io), watchdog_timer(io), notify_timer(io);
   every(status_timer, std::chrono::milliseconds(500),
         [&] { server.broadcast("notify_machine_status", jobs.machine_status()); });
@@ -153,6 +175,7 @@ void serve(boost::asio::io_context& io, boost::asio::signal_set& signals, RpcSer
     spdlog::info("{}: stopping (machine held, cell made safe, jobs saved)", signal == SIGTERM ? "SIGTERM" : "SIGINT");
     systemd::notify_stopping("stopping");
     server.stop();
+    if (web) web->stop();
     status_timer.cancel();
     notify_timer.cancel();
     stopper = std::thread([&] {
@@ -205,6 +228,9 @@ int run(const fs::path& config_path, bool check_only) {
                                                                config->jobs.max_uploads, config->jobs.upload_idle_s});
   RpcServer server(io, rs, make_api_handler(jobs, uploads, ServerInfo{kVersion, machine->describe(), config->state_dir.string()}));
   server_ptr = &server;
+  // The console before the socket: a client that reaches the socket finds the console up too.
+  std::unique_ptr<http::HttpServer> web = start_web(io, config->http, jobs);
+  if (config->http.host && !web) return 1;
   if (!start_listening(server, activated, rs)) return 1;
   if (auto r = jobs.start(); !r) {
     spdlog::error("{}", r.error().message);
@@ -215,7 +241,7 @@ int run(const fs::path& config_path, bool check_only) {
                rs.tcp_host ? fmt::format(", tcp {}:{}", *rs.tcp_host, server.tcp_port()) : std::string(),
                machine->describe(), config->state_dir.string());
   systemd::notify_ready(jobs.status_line());
-  serve(io, signals, server, jobs);
+  serve(io, signals, server, web.get(), jobs);
   jobs.shutdown("the daemon was stopped");
   spdlog::info("stopped");
   return 0;

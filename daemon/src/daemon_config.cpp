@@ -171,11 +171,12 @@ class Section {
 };
 
 constexpr std::array kRootKeys{"state_dir"sv};
-constexpr std::array kSections{"server"sv, "link"sv, "cell"sv, "planner"sv, "jobs"sv};
+constexpr std::array kSections{"server"sv, "http"sv, "link"sv, "cell"sv, "planner"sv, "jobs"sv};
 constexpr std::array kServerKeys{"socket"sv,        "socket_mode"sv,       "socket_group"sv,
                                  "tcp"sv,           "token"sv,             "token_file"sv,
                                  "max_request_bytes"sv, "max_clients"sv,   "idle_timeout_s"sv,
                                  "pre_auth_timeout_s"sv};
+constexpr std::array kHttpKeys{"listen"sv, "static_dir"sv, "idle_timeout_s"sv, "max_connections"sv};
 constexpr std::array kLinkKeys{"protocol"sv, "port"sv, "tcp"sv, "baud"sv, "rx_buffer"sv, "status_hz"sv, "stall_margin_s"sv};
 constexpr std::array kCellKeys{"enabled"sv, "modbus"sv, "modbus_unit"sv, "modbus_timeout_s"sv,
                                "modbus_reconnects"sv, "heartbeat_period_s"sv, "pump_ready_timeout_s"sv,
@@ -242,6 +243,24 @@ void read_server(Section s, ServerConfig& c) {
   s.integer("max_clients", c.max_clients, 1, 4096);
   s.number("idle_timeout_s", c.idle_timeout_s, {0, 7 * 24 * 3600});
   s.number("pre_auth_timeout_s", c.pre_auth_timeout_s, {0.1, 600});
+}
+
+void read_http(Section s, HttpConfig& c) {
+  std::string listen = fmt::format("{}:{}", c.host.value_or(""), c.port);
+  s.host_port("listen", listen);
+  if (listen.empty()) c.host.reset();
+  if (const auto hp = drivers::parse_host_port(listen)) {
+    c.host = hp->first;
+    c.port = hp->second;
+    // The console has no login yet: it may only be reached from this machine.
+    if (*c.host != "127.0.0.1" && *c.host != "::1" && *c.host != "localhost")
+      s.fail("listen", fmt::format("{} is not a loopback address; the web console serves other machines only once "
+                                   "users are configured, which this version does not support yet",
+                                   *c.host));
+  }
+  s.path("static_dir", c.static_dir);
+  s.number("idle_timeout_s", c.idle_timeout_s, {0.1, 3600});
+  s.integer("max_connections", c.max_connections, 1, 4096);
 }
 
 void read_link(Section s, MachineLinkConfig& c) {
@@ -374,6 +393,7 @@ std::expected<DaemonConfig, ConfigError> parse(const std::string& text, const st
   c.state_dir = state_dir;
 
   read_server(Section(r, "server", section_table(r, doc, "server"), kServerKeys), c.server);
+  read_http(Section(r, "http", section_table(r, doc, "http"), kHttpKeys), c.http);
   Section link(r, "link", section_table(r, doc, "link"), kLinkKeys);
   read_link(link, c.link);
   read_cell(Section(r, "cell", section_table(r, doc, "cell"), kCellKeys), c.cell);

@@ -52,12 +52,15 @@ struct Cell {
   TempDir dir;  // before sim: it outlives the process
   SimProcess sim;
 
-  std::string config(const std::string& extra_server = "") const {
+  // `http`: the [http] section's lines (off unless a test serves the console).
+  std::string config(const std::string& extra_server = "", const std::string& http = "listen = \"\"") const {
     return fmt::format(R"(state_dir = "{state}"
 [server]
 socket = "{sock}"
 socket_group = ""
 {extra}
+[http]
+{http}
 [link]
 protocol = "grbl"
 port = "{cnc}"
@@ -71,7 +74,7 @@ memory_limit_mb = {memory_mb}
 roots = ["{examples}", "{parts}"]
 )",
                        fmt::arg("state", dir.file("state")), fmt::arg("sock", dir.file("lamina.sock")),
-                       fmt::arg("extra", extra_server), fmt::arg("cnc", dir.file("cnc")),
+                       fmt::arg("extra", extra_server), fmt::arg("http", http), fmt::arg("cnc", dir.file("cnc")),
                        fmt::arg("modbus", sim.modbus_port()), fmt::arg("lamina", LAMINA_CLI),
                        fmt::arg("examples", LAMINA_EXAMPLES_DIR), fmt::arg("parts", dir.file("parts")),
                        // A sanitizer build reserves terabytes of shadow address space.

@@ -63,6 +63,11 @@ void expect_same(const DaemonConfig& a, const DaemonConfig& b) {
   EXPECT_EQ(a.server.max_clients, b.server.max_clients);
   EXPECT_EQ(a.server.idle_timeout_s, b.server.idle_timeout_s);
   EXPECT_EQ(a.server.pre_auth_timeout_s, b.server.pre_auth_timeout_s);
+  EXPECT_EQ(a.http.host, b.http.host);
+  EXPECT_EQ(a.http.port, b.http.port);
+  EXPECT_EQ(a.http.static_dir, b.http.static_dir);
+  EXPECT_EQ(a.http.idle_timeout_s, b.http.idle_timeout_s);
+  EXPECT_EQ(a.http.max_connections, b.http.max_connections);
   EXPECT_EQ(a.link.protocol, b.link.protocol);
   EXPECT_EQ(a.link.port, b.link.port);
   EXPECT_EQ(a.link.tcp, b.link.tcp);
@@ -112,7 +117,8 @@ TEST(DaemonConfig, TheDefaultsFileShowsEveryKey) {
                           "modbus", "heartbeat_period_s", "pump_ready_timeout_s", "pressure_setpoint_mpa",
                           "abrasive_g_per_min", "hold_limit_s", "jet_restart_s", "lamina", "workers", "machine",
                           "materials", "timeout_s", "memory_limit_mb", "cpu_limit_s", "nice", "roots",
-                          "max_model_bytes", "max_stock_file_bytes", "upload_idle_s", "max_uploads"})
+                          "max_model_bytes", "max_stock_file_bytes", "upload_idle_s", "max_uploads", "listen",
+                          "static_dir", "max_connections"})
     EXPECT_NE(text.find(std::string("\n") + key + " = "), std::string::npos) << key;
 }
 
@@ -149,6 +155,23 @@ TEST(DaemonConfig, JobsRoots) {
   EXPECT_NE(error_of("[jobs]\nroots = [\"\"]\n").find("non-empty"), std::string::npos);
   EXPECT_NE(error_of("[planner]\nmemory_limit_mb = 100\n").find("at least 256"), std::string::npos);
   EXPECT_NE(error_of("[planner]\nnice = 20\n").find("[planner] nice: 20 is out of range [0, 19]"), std::string::npos);
+}
+
+// The web console (issue 19): on at 127.0.0.1:8080 unless turned off; another machine may reach
+// it only once it has users and logins, which it has not yet.
+TEST(DaemonConfig, TheWebConsoleListensOnLoopbackOnly) {
+  auto on = parse_daemon_config("[http]\nlisten = \"127.0.0.1:9090\"\nstatic_dir = \"web\"\n", "/etc/lamina/x.toml");
+  ASSERT_TRUE(on.has_value()) << on.error().message;
+  EXPECT_EQ(on->http.host, "127.0.0.1");
+  EXPECT_EQ(on->http.port, 9090);
+  EXPECT_EQ(on->http.static_dir, "/etc/lamina/web");
+  auto off = parse_daemon_config("[http]\nlisten = \"\"\n", "x.toml");
+  ASSERT_TRUE(off.has_value()) << off.error().message;
+  EXPECT_FALSE(off->http.host);
+  const std::string wide = error_of("[http]\nlisten = \"0.0.0.0:8080\"\n");
+  EXPECT_NE(wide.find("test.toml:2: [http] listen: 0.0.0.0 is not a loopback address"), std::string::npos) << wide;
+  EXPECT_NE(error_of("[http]\nlisten = \"8080\"\n").find("[http] listen: expected \"HOST:PORT\""), std::string::npos);
+  EXPECT_NE(error_of("[http]\nmax_connections = 0\n").find("[http] max_connections"), std::string::npos);
 }
 
 TEST(DaemonConfig, AnEmptyFileKeepsTheDefaults) {

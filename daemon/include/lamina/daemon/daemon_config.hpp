@@ -65,9 +65,19 @@ struct JobsConfig {
   std::size_t max_uploads = 16;            // unfinished at once
 };
 
+// [http]: the web console (issue 19).
+struct HttpConfig {
+  std::optional<std::string> host = "127.0.0.1";  // [http] listen = "HOST:PORT"; "" (nullopt): no web server
+  int port = 8080;
+  std::string static_dir = "/usr/share/lamina/web";  // the console's built files
+  double idle_timeout_s = 30;              // a connection silent this long is closed
+  std::size_t max_connections = 64;
+};
+
 struct DaemonConfig {
   std::filesystem::path state_dir = "/var/lib/lamina";
   ServerConfig server;
+  HttpConfig http;
   MachineLinkConfig link;
   CellConfig cell;
   PlannerConfig planner;

@@ -1,0 +1,56 @@
+#pragma once
+// laminad's web server (issue 19), on the daemon's io_context: the console's files and each
+// job's artefacts over plain HTTP GET. Routing is http_routes (sans-IO); this file moves bytes.
+// A connection gets the limits of an RPC client: a bounded request head, an idle timeout, a
+// bounded number of connections; a file is read in chunks as the client takes it.
+#include <cstddef>
+#include <expected>
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <string>
+
+#include <boost/asio/io_context.hpp>
+
+#include "http/http_routes.hpp"
+
+namespace lamina::daemon::http {
+
+struct HttpSettings {
+  std::string host = "127.0.0.1";
+  int port = 8080;                     // 0: any free port (tests); port() says which
+  std::filesystem::path static_dir;    // the console's files; empty: none are served
+  double idle_timeout_s = 30;          // a connection that sends nothing this long is closed
+  std::size_t max_header_bytes = 8192;
+  std::size_t max_connections = 64;    // beyond: 503 and close
+};
+
+// A job's artefact as a file to send, or why not (404: no such job or no such file yet).
+using ArtefactLookup = std::function<std::expected<std::filesystem::path, RouteError>(const ArtefactRequest&)>;
+
+class HttpServer {
+ public:
+  HttpServer(boost::asio::io_context& io, HttpSettings settings, ArtefactLookup artefacts);
+  ~HttpServer();
+  HttpServer(const HttpServer&) = delete;
+  HttpServer& operator=(const HttpServer&) = delete;
+
+  // Binds and listens; the error names the address.
+  std::expected<void, std::string> listen();
+  int port() const;
+  // Stop accepting; close every connection. Thread-safe.
+  void stop();
+  std::size_t connection_count() const;
+
+  struct Impl;  // the listener's state, shared with its connections (http_server.cpp)
+
+ private:
+  std::shared_ptr<Impl> impl_;
+};
+
+// The static file a StaticRequest names under `root`, if it is a regular file there: the real
+// path (symlinks resolved) must stay inside the real root.
+std::expected<std::filesystem::path, RouteError> resolve_static(const std::filesystem::path& root,
+                                                                const StaticRequest& request);
+
+}  // namespace lamina::daemon::http
