@@ -61,19 +61,16 @@ SectionLines::SectionLines(const Mesh& mesh, const Slice& slice) : z_mm_(slice.z
   });
 }
 
-std::optional<LineCrossing> SectionLines::exit_crossing(const Eigen::Vector2d& origin, const Eigen::Vector2d& direction,
-                                                        double u_min, double u_max, CrossingPick pick) const {
-  if (segments_.empty() || !(u_max >= u_min)) return std::nullopt;
-  // Clip the query to the grid's box (slab test), then walk its cells (Amanatides & Woo).
-  double t0 = u_min, t1 = u_max;
-  const Eigen::Vector2d& grid_origin = grid_.origin();
-  const double cell_mm = grid_.cell_mm();
-  const int nx = grid_.nx(), ny = grid_.ny();
-  const Eigen::Vector2d& box_lo = grid_origin;
-  const Eigen::Vector2d box_hi = grid_origin + Eigen::Vector2d(nx, ny) * cell_mm;
+namespace {
+// Narrows [t0, t1] of the line origin + t·direction to the grid's box (slab test); false when
+// the line misses the box there.
+bool clip_to_grid(const BoxGrid& grid, const Eigen::Vector2d& origin, const Eigen::Vector2d& direction, double& t0,
+                  double& t1) {
+  const Eigen::Vector2d& box_lo = grid.origin();
+  const Eigen::Vector2d box_hi = grid.origin() + Eigen::Vector2d(grid.nx(), grid.ny()) * grid.cell_mm();
   for (int k = 0; k < 2; ++k) {
     if (std::abs(direction[k]) < 1e-300) {
-      if (origin[k] < box_lo[k] || origin[k] > box_hi[k]) return std::nullopt;
+      if (origin[k] < box_lo[k] || origin[k] > box_hi[k]) return false;
       continue;
     }
     double a = (box_lo[k] - origin[k]) / direction[k];
@@ -82,7 +79,19 @@ std::optional<LineCrossing> SectionLines::exit_crossing(const Eigen::Vector2d& o
     t0 = std::max(t0, a);
     t1 = std::min(t1, b);
   }
-  if (t0 > t1) return std::nullopt;
+  return t0 <= t1;
+}
+}  // namespace
+
+std::optional<LineCrossing> SectionLines::exit_crossing(const Eigen::Vector2d& origin, const Eigen::Vector2d& direction,
+                                                        double u_min, double u_max, CrossingPick pick) const {
+  if (segments_.empty() || !(u_max >= u_min)) return std::nullopt;
+  // Clip the query to the grid's box, then walk its cells (Amanatides & Woo).
+  double t0 = u_min, t1 = u_max;
+  if (!clip_to_grid(grid_, origin, direction, t0, t1)) return std::nullopt;
+  const Eigen::Vector2d& grid_origin = grid_.origin();
+  const double cell_mm = grid_.cell_mm();
+  const int nx = grid_.nx(), ny = grid_.ny();
 
   const Eigen::Vector2d start = origin + t0 * direction;
   int cx = grid_.column(start.x()), cy = grid_.row(start.y());

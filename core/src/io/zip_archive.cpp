@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <climits>
+#include <optional>
 
 #if defined(LAMINA_HAVE_ZLIB) && __has_include(<zlib.h>)
 #include <zlib.h>
@@ -89,24 +90,26 @@ bool zip_support_compiled() {
 #endif
 }
 
+// The end of central directory record: in the last 22 + 65535 (comment) bytes, the last one.
+// The caller has checked that the archive holds at least one record's bytes.
+static std::optional<std::size_t> find_end_record(std::span<const std::byte> zip) {
+  const std::size_t lowest = zip.size() > kEndRecordBytes + 0xffff ? zip.size() - kEndRecordBytes - 0xffff : 0;
+  std::size_t end = zip.size() - kEndRecordBytes + 1;
+  while (end-- > lowest)
+    if (u32(zip, end) == kEndOfCentralDirectory) return end;
+  return std::nullopt;
+}
+
 std::expected<std::vector<ZipEntry>, Error> list_zip(std::span<const std::byte> zip, std::string_view name,
                                                     const FileQuote& quote) {
   if (zip.size() < kEndRecordBytes) {
     return std::unexpected(zip_error(ErrorCode::unknown_format, name, "not a zip archive (too short)"));
   }
-  // The end record sits in the last 22 + 65535 (comment) bytes.
-  const std::size_t lowest = zip.size() > kEndRecordBytes + 0xffff ? zip.size() - kEndRecordBytes - 0xffff : 0;
-  std::size_t end = zip.size() - kEndRecordBytes + 1;
-  bool found = false;
-  while (end-- > lowest) {
-    if (u32(zip, end) == kEndOfCentralDirectory) {
-      found = true;
-      break;
-    }
-  }
-  if (!found) {
+  const std::optional<std::size_t> end_record = find_end_record(zip);
+  if (!end_record) {
     return std::unexpected(zip_error(ErrorCode::unknown_format, name, "not a zip archive (no central directory)"));
   }
+  const std::size_t end = *end_record;
   std::uint32_t disk = u16(zip, end + 4), cd_disk = u16(zip, end + 6);
   std::uint64_t entries = u16(zip, end + 10);
   std::uint64_t cd_size = u32(zip, end + 12), cd_offset = u32(zip, end + 16);
