@@ -2,7 +2,10 @@
 // on worker threads, and cuts them through the machine link while it minds the cell's PLC.
 // One io_context thread serves the sockets; SIGTERM stops it cleanly (the machine held, the
 // cell made safe, the job interrupted and saved). systemd: Type=notify, watchdog, socket activation.
+#include <termios.h>
 #include <unistd.h>
+
+#include <iostream>
 
 #include <chrono>
 #include <cstdlib>
@@ -20,6 +23,7 @@
 
 #include "api_methods.hpp"
 #include "http/http_server.hpp"
+#include "http/passwords.hpp"
 #include "http/job_artefacts.hpp"
 #include "job_manager.hpp"
 #include "lamina/daemon/daemon_config.hpp"
@@ -140,7 +144,16 @@ bool start_listening(RpcServer& server, const std::vector<int>& activated, const
 
 // [http] listen set: the web console's server, listening (nullptr and the error logged if it
 // cannot; nullptr without a word when [http] is off).
-std::unique_ptr<http::HttpServer> start_web(boost::asio::io_context& io, const HttpConfig& c, const JobManager& jobs) {
+std::string machine_name() {
+  char name[256] = {};
+  return ::gethostname(name, sizeof name - 1) == 0 ? std::string(name) : std::string();
+}
+
+// The console's HTTP server; a browser's WebSocket becomes a client of the RPC server, with
+// the user and role of its login.
+std::unique_ptr<http::HttpServer> start_web(boost::asio::io_context& io, const DaemonConfig& config,
+                                            const JobManager& jobs, RpcServer& rpc) {
+  const HttpConfig& c = config.http;
   if (!c.host) return nullptr;
   http::HttpSettings s;
   s.host = *c.host == "localhost" ? "127.0.0.1" : *c.host;
@@ -148,12 +161,18 @@ std::unique_ptr<http::HttpServer> start_web(boost::asio::io_context& io, const H
   s.static_dir = c.static_dir;
   s.idle_timeout_s = c.idle_timeout_s;
   s.max_connections = c.max_connections;
-  auto web = std::make_unique<http::HttpServer>(io, s, http::job_artefacts(jobs));
+  s.max_request_bytes = config.server.max_request_bytes;
+  s.access = http::AccessSettings{c.users, c.session_hours * 3600, c.server_names, c.allowed_origins, machine_name()};
+  auto handoff = [&rpc](std::unique_ptr<RpcTransport> transport, const http::Visitor& who, std::string peer) {
+    return rpc.adopt(std::move(transport), Via::websocket, who.user, who.role, std::move(peer));
+  };
+  auto web = std::make_unique<http::HttpServer>(io, s, http::job_artefacts(jobs), handoff);
   if (auto r = web->listen(); !r) {
     spdlog::error("{}", r.error());
     return nullptr;
   }
-  spdlog::info("web console: http://{}:{}/ (files from {})", s.host, web->port(), s.static_dir.string());
+  spdlog::info("web console: http://{}:{}/ (files from {}; {})", s.host, web->port(), s.static_dir.string(),
+               c.users.empty() ? "no users: viewing only" : fmt::format("{} users", c.users.size()));
   return web;
 }
 
@@ -162,7 +181,8 @@ std::unique_ptr<http::HttpServer> start_web(boost::asio::io_context& io, const H
 void serve(boost::asio::io_context& io, boost::asio::signal_set& signals, RpcServer& server, http::HttpServer* web,
            JobManager& jobs) {
   boost::asio::steady_timer status_timer(io), watchdog_timer(io), notify_timer(io);
-  every(status_timer, std::chrono::milliseconds(500),
+  // 5 a second: the console's machine view moves as the head does (issue 19).
+  every(status_timer, std::chrono::milliseconds(200),
         [&] { server.broadcast("notify_machine_status", jobs.machine_status()); });
   every(notify_timer, std::chrono::milliseconds(2000), [&] { systemd::notify_status(jobs.status_line()); });
   if (const auto period = systemd::watchdog_period()) {
@@ -229,7 +249,7 @@ int run(const fs::path& config_path, bool check_only) {
   RpcServer server(io, rs, make_api_handler(jobs, uploads, ServerInfo{kVersion, machine->describe(), config->state_dir.string()}));
   server_ptr = &server;
   // The console before the socket: a client that reaches the socket finds the console up too.
-  std::unique_ptr<http::HttpServer> web = start_web(io, config->http, jobs);
+  std::unique_ptr<http::HttpServer> web = start_web(io, *config, jobs, server);
   if (config->http.host && !web) return 1;
   if (!start_listening(server, activated, rs)) return 1;
   if (auto r = jobs.start(); !r) {
@@ -247,6 +267,33 @@ int run(const fs::path& config_path, bool check_only) {
   return 0;
 }
 
+// The password is read without echo from a terminal, or as the first line of a pipe.
+int print_password_hash() {
+  const bool tty = ::isatty(STDIN_FILENO) == 1;
+  termios saved{};
+  if (tty) {
+    fmt::print(stderr, "password: ");
+    ::tcgetattr(STDIN_FILENO, &saved);
+    termios quiet = saved;
+    quiet.c_lflag &= ~static_cast<tcflag_t>(ECHO);
+    ::tcsetattr(STDIN_FILENO, TCSANOW, &quiet);
+  }
+  std::string password;
+  std::getline(std::cin, password);
+  if (tty) {
+    ::tcsetattr(STDIN_FILENO, TCSANOW, &saved);
+    fmt::print(stderr, "\n");
+  }
+  if (!password.empty() && password.back() == '\r') password.pop_back();
+  auto hashed = http::hash_password(password);
+  if (!hashed) {
+    fmt::print(stderr, "laminad --hash-password: {}\n", hashed.error());
+    return 2;
+  }
+  fmt::print("{}\n", *hashed);
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -255,8 +302,12 @@ int main(int argc, char** argv) {
   bool check = false;
   app.add_option("--config", config_path, "configuration file (TOML)");
   app.add_flag("--check-config", check, "validate the configuration and exit");
+  bool hash = false;
+  app.add_flag("--hash-password", hash,
+               "read a password on standard input and print its Argon2id hash for [[http.users]] password_hash");
   app.set_version_flag("--version", std::string("laminad ") + kVersion);
   CLI11_PARSE(app, argc, argv);
+  if (hash) return print_password_hash();
   setup_logging();
   try {
     return run(config_path, check);

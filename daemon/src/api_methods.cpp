@@ -13,6 +13,15 @@ namespace {
 using Json = nlohmann::json;
 using Method = std::function<RpcResult(const Json& params, ClientContext& client)>;
 
+// One row per method: who may call it (roles.hpp) and what it does. Reading is a viewer's.
+struct MethodRow {
+  Role role = Role::viewer;
+  Method call;
+};
+using MethodTable = std::map<std::string, MethodRow>;
+
+Actor actor_of(const ClientContext& client) { return Actor{client.user, client.role}; }
+
 RpcError invalid(std::string message) { return RpcError{rpc_code::invalid_params, std::move(message), nullptr}; }
 
 // params must be an object (positional arrays are not used by this API).
@@ -52,8 +61,8 @@ RpcResult machine_result(std::expected<Json, JobError> r) {
 }
 
 // upload.begin / chunk / cancel: a model sent in pieces (uploads.hpp).
-void add_upload_methods(std::map<std::string, Method>& m, Uploads& uploads) {
-  m["upload.begin"] = [&uploads](const Json& params, ClientContext&) -> RpcResult {
+void add_upload_methods(MethodTable& m, Uploads& uploads) {
+  m["upload.begin"] = {Role::engineer, [&uploads](const Json& params, ClientContext&) -> RpcResult {
     auto p = object_params(params);
     if (!p) return std::unexpected(p.error());
     auto name = string_param(params, "name");
@@ -63,8 +72,8 @@ void add_upload_methods(std::map<std::string, Method>& m, Uploads& uploads) {
     auto id = uploads.begin(*name, params["size"].get<std::uint64_t>());
     if (!id) return std::unexpected(rpc_error(id.error()));
     return Json{{"upload", *id}};
-  };
-  m["upload.chunk"] = [&uploads](const Json& params, ClientContext&) -> RpcResult {
+  }};
+  m["upload.chunk"] = {Role::engineer, [&uploads](const Json& params, ClientContext&) -> RpcResult {
     auto p = object_params(params);
     if (!p) return std::unexpected(p.error());
     auto id = string_param(params, "upload");
@@ -76,15 +85,15 @@ void add_upload_methods(std::map<std::string, Method>& m, Uploads& uploads) {
     auto received = uploads.chunk(*id, params["offset"].get<std::uint64_t>(), *data);
     if (!received) return std::unexpected(rpc_error(received.error()));
     return Json{{"received", *received}};
-  };
-  m["upload.cancel"] = [&uploads](const Json& params, ClientContext&) -> RpcResult {
+  }};
+  m["upload.cancel"] = {Role::engineer, [&uploads](const Json& params, ClientContext&) -> RpcResult {
     auto p = object_params(params);
     if (!p) return std::unexpected(p.error());
     auto id = string_param(params, "upload");
     if (!id) return std::unexpected(id.error());
     if (auto r = uploads.cancel(*id); !r) return std::unexpected(rpc_error(r.error()));
     return Json{{"cancelled", *id}};
-  };
+  }};
 }
 
 }  // namespace
@@ -106,10 +115,11 @@ RpcError rpc_error(const JobError& e) {
 namespace {
 
 // job.submit: a model named on the cell PC or sent with upload.begin, with plan settings.
-RpcResult submit_job(JobManager& jobs, Uploads& uploads, const Json& params) {
+RpcResult submit_job(JobManager& jobs, Uploads& uploads, const Json& params, const Actor& by) {
   auto p = object_params(params);
   if (!p) return std::unexpected(p.error());
   SubmitRequest r;
+  r.by = by;
   if (params.contains("upload") == params.contains("model"))
     return std::unexpected(invalid("params: give either model (a path on the cell PC) or upload (from upload.begin)"));
   for (const auto& [key, value] : params.items())
@@ -138,59 +148,86 @@ RpcResult submit_job(JobManager& jobs, Uploads& uploads, const Json& params) {
 }
 
 // job.*: one job each, named by params.job.
-void add_job_methods(std::map<std::string, Method>& m, JobManager& jobs, Uploads& uploads) {
-  m["job.submit"] = [&jobs, &uploads](const Json& params, ClientContext&) { return submit_job(jobs, uploads, params); };
-  m["job.list"] = [&jobs](const Json&, ClientContext&) -> RpcResult {
-    Json list = Json::array();
-    for (const JobRecord& j : jobs.list())
-      list.push_back({{"id", j.id}, {"state", to_string(j.state)}, {"name", j.name}, {"current_sheet", j.current_sheet},
-                      {"sheets", j.sheets.size()}, {"error", j.error}, {"created_unix_ms", j.created_unix_ms}});
-    return list;
+void add_job_methods(MethodTable& m, JobManager& jobs, Uploads& uploads) {
+  m["job.submit"] = {Role::engineer, [&jobs, &uploads](const Json& params, ClientContext& client) {
+                       return submit_job(jobs, uploads, params, actor_of(client));
+                     }};
+  m["job.list"] = {Role::viewer, [&jobs](const Json&, ClientContext&) -> RpcResult {
+                     Json list = Json::array();
+                     for (const JobRecord& j : jobs.list())
+                       list.push_back({{"id", j.id}, {"state", to_string(j.state)}, {"name", j.name},
+                                       {"current_sheet", j.current_sheet}, {"sheets", j.sheets.size()},
+                                       {"error", j.error}, {"created_unix_ms", j.created_unix_ms}});
+                     return list;
+                   }};
+  using JobCall = std::function<std::expected<JobRecord, JobError>(const std::string&, const Json&, const Actor&)>;
+  auto with_job = [](Role role, JobCall f) {
+    return MethodRow{role, [f](const Json& params, ClientContext& client) -> RpcResult {
+                       auto p = object_params(params);
+                       if (!p) return std::unexpected(p.error());
+                       auto id = string_param(params, "job");
+                       if (!id) return std::unexpected(id.error());
+                       return job_result(f(*id, params, actor_of(client)));
+                     }};
   };
-  auto with_job = [](std::function<std::expected<JobRecord, JobError>(const std::string&, const Json&)> f) {
-    return [f](const Json& params, ClientContext&) -> RpcResult {
-      auto p = object_params(params);
-      if (!p) return std::unexpected(p.error());
-      auto id = string_param(params, "job");
-      if (!id) return std::unexpected(id.error());
-      return job_result(f(*id, params));
-    };
-  };
-  m["job.get"] = with_job([&jobs](const std::string& id, const Json&) { return jobs.get(id); });
-  m["job.cancel"] = with_job([&jobs](const std::string& id, const Json&) { return jobs.cancel(id); });
-  m["job.resume"] = with_job([&jobs](const std::string& id, const Json&) { return jobs.resume(id); });
-  m["job.confirm_sheet"] = with_job([&jobs](const std::string& id, const Json& params) -> std::expected<JobRecord, JobError> {
-    auto sheet = int_param(params, "sheet", 1, 100000);
-    if (!sheet) return std::unexpected(job_error(JobErrorKind::bad_request, sheet.error().message));
-    return jobs.confirm_sheet(id, *sheet);
+  m["job.get"] = with_job(Role::viewer, [&jobs](const std::string& id, const Json&, const Actor&) { return jobs.get(id); });
+  m["job.events"] = {Role::viewer, [&jobs](const Json& params, ClientContext&) -> RpcResult {
+                       auto id = string_param(params, "job");
+                       if (!id) return std::unexpected(id.error());
+                       auto events = jobs.events(*id);
+                       if (!events) return std::unexpected(rpc_error(events.error()));
+                       Json list = Json::array();
+                       for (const JobEvent& e : *events)
+                         list.push_back({{"t_unix_ms", e.t_unix_ms}, {"kind", e.kind}, {"data", e.data}});
+                       return list;
+                     }};
+  m["job.cancel"] = with_job(Role::engineer, [&jobs](const std::string& id, const Json&, const Actor& by) {
+    return jobs.cancel(id, by);
   });
+  m["job.resume"] = with_job(Role::machine_operator, [&jobs](const std::string& id, const Json&, const Actor& by) {
+    return jobs.resume(id, by);
+  });
+  m["job.confirm_sheet"] = with_job(
+      Role::machine_operator,
+      [&jobs](const std::string& id, const Json& params, const Actor& by) -> std::expected<JobRecord, JobError> {
+        auto sheet = int_param(params, "sheet", 1, 100000);
+        if (!sheet) return std::unexpected(job_error(JobErrorKind::bad_request, sheet.error().message));
+        return jobs.confirm_sheet(id, *sheet, by);
+      });
 }
 
 // machine.*: the machine, whichever job has it.
-void add_machine_methods(std::map<std::string, Method>& m, JobManager& jobs) {
-  m["machine.status"] = [&jobs](const Json&, ClientContext&) -> RpcResult { return jobs.machine_status(); };
-  m["machine.hold"] = [&jobs](const Json&, ClientContext&) -> RpcResult { return machine_result(jobs.hold()); };
-  m["machine.resume"] = [&jobs](const Json&, ClientContext&) -> RpcResult { return machine_result(jobs.resume_motion()); };
-  m["machine.abort"] = [&jobs](const Json& params, ClientContext&) -> RpcResult {
-    std::string why = "aborted by the operator";
-    if (params.is_object() && params.contains("reason") && params["reason"].is_string()) why = params["reason"];
-    return machine_result(jobs.abort(why));
-  };
+void add_machine_methods(MethodTable& m, JobManager& jobs) {
+  m["machine.status"] = {Role::viewer, [&jobs](const Json&, ClientContext&) -> RpcResult { return jobs.machine_status(); }};
+  m["machine.hold"] = {Role::machine_operator, [&jobs](const Json&, ClientContext& client) -> RpcResult {
+                         return machine_result(jobs.hold(actor_of(client)));
+                       }};
+  m["machine.resume"] = {Role::machine_operator, [&jobs](const Json&, ClientContext& client) -> RpcResult {
+                           return machine_result(jobs.resume_motion(actor_of(client)));
+                         }};
+  m["machine.abort"] = {Role::machine_operator, [&jobs](const Json& params, ClientContext& client) -> RpcResult {
+                          std::string why = "aborted by the operator";
+                          if (params.is_object() && params.contains("reason") && params["reason"].is_string())
+                            why = params["reason"];
+                          return machine_result(jobs.abort(why, actor_of(client)));
+                        }};
 }
 
 }  // namespace
 
 RpcServer::Handler make_api_handler(JobManager& jobs, Uploads& uploads, ServerInfo info) {
-  auto methods = std::make_shared<std::map<std::string, Method>>();
+  auto methods = std::make_shared<MethodTable>();
   auto& m = *methods;
-  m["server.info"] = [info](const Json&, ClientContext&) -> RpcResult {
-    return Json{{"name", "laminad"}, {"version", info.version}, {"machine", info.machine}, {"state_dir", info.state_dir},
-                {"api", 1}};
-  };
-  m["server.subscribe"] = [](const Json&, ClientContext& client) -> RpcResult {
-    client.subscribed = true;
-    return Json{{"subscribed", true}, {"notifications", {"notify_job_progress", "notify_machine_status"}}};
-  };
+  m["server.info"] = {Role::viewer, [info](const Json&, ClientContext& client) -> RpcResult {
+                        return Json{{"name", "laminad"}, {"version", info.version}, {"machine", info.machine},
+                                    {"state_dir", info.state_dir}, {"api", 1}, {"user", client.user},
+                                    {"role", role_name(client.role)}};
+                      }};
+  m["server.subscribe"] = {Role::viewer, [](const Json&, ClientContext& client) -> RpcResult {
+                             client.subscribed = true;
+                             return Json{{"subscribed", true},
+                                         {"notifications", {"notify_job_progress", "notify_machine_status"}}};
+                           }};
   add_upload_methods(m, uploads);
   add_job_methods(m, jobs, uploads);
   add_machine_methods(m, jobs);
@@ -198,7 +235,13 @@ RpcServer::Handler make_api_handler(JobManager& jobs, Uploads& uploads, ServerIn
     auto it = methods->find(request.method);
     if (it == methods->end())
       return std::unexpected(RpcError{rpc_code::method_not_found, fmt::format("no method '{}'", request.method), nullptr});
-    return it->second(request.params, client);
+    // Refused out loud, never ignored: the console shows this message to the person who pressed.
+    if (client.role < it->second.role)
+      return std::unexpected(RpcError{rpc_code::forbidden,
+                                      fmt::format("{} is for an {} or above; {} is a {}", request.method,
+                                                  role_name(it->second.role), client.user, role_name(client.role)),
+                                      Json{{"needs", role_name(it->second.role)}, {"role", role_name(client.role)}}});
+    return it->second.call(request.params, client);
   };
 }
 

@@ -1,11 +1,13 @@
 #include "lamina/daemon/daemon_config.hpp"
 
 #include "lamina/drivers/modbus_endpoint.hpp"
+#include "http/passwords.hpp"
 
 #include <fmt/format.h>
 #include <sys/un.h>
 #include <toml++/toml.h>
 
+#include <algorithm>
 #include <array>
 #include <cerrno>
 #include <cmath>
@@ -176,7 +178,9 @@ constexpr std::array kServerKeys{"socket"sv,        "socket_mode"sv,       "sock
                                  "tcp"sv,           "token"sv,             "token_file"sv,
                                  "max_request_bytes"sv, "max_clients"sv,   "idle_timeout_s"sv,
                                  "pre_auth_timeout_s"sv};
-constexpr std::array kHttpKeys{"listen"sv, "static_dir"sv, "idle_timeout_s"sv, "max_connections"sv};
+constexpr std::array kHttpKeys{"listen"sv,         "static_dir"sv,   "idle_timeout_s"sv, "max_connections"sv,
+                               "users"sv,          "session_hours"sv, "server_names"sv,  "allowed_origins"sv};
+constexpr std::array kWebUserKeys{"name"sv, "role"sv, "password_hash"sv};
 constexpr std::array kLinkKeys{"protocol"sv, "port"sv, "tcp"sv, "baud"sv, "rx_buffer"sv, "status_hz"sv, "stall_margin_s"sv};
 constexpr std::array kCellKeys{"enabled"sv, "modbus"sv, "modbus_unit"sv, "modbus_timeout_s"sv,
                                "modbus_reconnects"sv, "heartbeat_period_s"sv, "pump_ready_timeout_s"sv,
@@ -245,22 +249,70 @@ void read_server(Section s, ServerConfig& c) {
   s.number("pre_auth_timeout_s", c.pre_auth_timeout_s, {0.1, 600});
 }
 
-void read_http(Section s, HttpConfig& c) {
+// [[http.users]]: each a name, a role and an Argon2id hash; names are unique.
+void read_web_users(Reader& r, Section& s, std::vector<WebUser>& users) {
+  const toml::node* n = s.node("users");
+  if (!n) return;
+  const auto* list = n->as_array();
+  if (!list) return s.fail("users", "expected [[http.users]] tables (name, role, password_hash)");
+  for (const toml::node& entry : *list) {
+    const auto* table = entry.as_table();
+    if (!table) return s.fail("users", "expected [[http.users]] tables (name, role, password_hash)");
+    Section u(r, "http.users", table, kWebUserKeys);
+    // A misspelt key is the message that helps, not the key then found missing.
+    const bool misspelt = std::any_of(table->begin(), table->end(), [](const auto& kv) {
+      return std::find(kWebUserKeys.begin(), kWebUserKeys.end(), kv.first.str()) == kWebUserKeys.end();
+    });
+    if (misspelt) continue;
+    WebUser user;
+    std::string role;
+    u.string("name", user.name);
+    u.string("role", role);
+    u.string("password_hash", user.password_hash);
+    if (user.name.empty() || user.name.size() > 64 || user.name.find_first_of(" \t\r\n:") != std::string::npos)
+      u.fail("name", "expected a name of 1-64 characters without spaces or ':'");
+    for (const WebUser& other : users)
+      if (other.name == user.name) u.fail("name", fmt::format("'{}' is named twice", user.name));
+    if (const auto parsed = role_from_name(role)) user.role = *parsed;
+    else u.fail("role", fmt::format("\"{}\" is not one of viewer, operator, engineer", role));
+    if (auto ok = http::check_password_hash(user.password_hash); !ok) u.fail("password_hash", ok.error());
+    users.push_back(std::move(user));
+  }
+}
+
+void read_strings(Section& s, std::string_view key, std::vector<std::string>& out) {
+  const toml::node* n = s.node(key);
+  if (!n) return;
+  const auto* list = n->as_array();
+  if (!list) return s.fail(key, "expected an array of strings");
+  out.clear();
+  for (const toml::node& item : *list) {
+    if (!item.is_string()) return s.fail(key, "expected an array of strings");
+    out.push_back(item.as_string()->get());
+  }
+}
+
+bool is_loopback_host(const std::string& host) { return host == "127.0.0.1" || host == "::1" || host == "localhost"; }
+
+void read_http(Reader& r, Section s, HttpConfig& c) {
   std::string listen = fmt::format("{}:{}", c.host.value_or(""), c.port);
   s.host_port("listen", listen);
   if (listen.empty()) c.host.reset();
+  read_web_users(r, s, c.users);
   if (const auto hp = drivers::parse_host_port(listen)) {
     c.host = hp->first;
     c.port = hp->second;
-    // The console has no login yet: it may only be reached from this machine.
-    if (*c.host != "127.0.0.1" && *c.host != "::1" && *c.host != "localhost")
-      s.fail("listen", fmt::format("{} is not a loopback address; the web console serves other machines only once "
-                                   "users are configured, which this version does not support yet",
+    if (!is_loopback_host(*c.host) && c.users.empty())
+      s.fail("listen", fmt::format("{} is not a loopback address; without [[http.users]] the console is served to this "
+                                   "machine only (add users, each with a role and a password hash)",
                                    *c.host));
   }
   s.path("static_dir", c.static_dir);
   s.number("idle_timeout_s", c.idle_timeout_s, {0.1, 3600});
   s.integer("max_connections", c.max_connections, 1, 4096);
+  s.number("session_hours", c.session_hours, {0.01, 24 * 31});
+  read_strings(s, "server_names", c.server_names);
+  read_strings(s, "allowed_origins", c.allowed_origins);
 }
 
 void read_link(Section s, MachineLinkConfig& c) {
@@ -393,7 +445,7 @@ std::expected<DaemonConfig, ConfigError> parse(const std::string& text, const st
   c.state_dir = state_dir;
 
   read_server(Section(r, "server", section_table(r, doc, "server"), kServerKeys), c.server);
-  read_http(Section(r, "http", section_table(r, doc, "http"), kHttpKeys), c.http);
+  read_http(r, Section(r, "http", section_table(r, doc, "http"), kHttpKeys), c.http);
   Section link(r, "link", section_table(r, doc, "link"), kLinkKeys);
   read_link(link, c.link);
   read_cell(Section(r, "cell", section_table(r, doc, "cell"), kCellKeys), c.cell);

@@ -136,6 +136,14 @@ std::expected<void, JobError> JobManager::set_state(JobRecord& job, JobState to,
   return {};
 }
 
+// Before the state change it causes, so the log reads cause then effect.
+void JobManager::action(const JobRecord& job, const std::string& what, const Actor& by, nlohmann::json data) {
+  data["action"] = what;
+  data["by"] = by.user;
+  data["role"] = role_name(by.role);
+  event(job, "action", std::move(data));
+}
+
 void JobManager::event(const JobRecord& job, const std::string& kind, nlohmann::json data) {
   if (auto r = store_.add_event(JobEvent{job.id, now_unix_ms(), kind, std::move(data)}); !r) store_failed(r.error().message);
 }
@@ -260,7 +268,8 @@ std::expected<JobRecord, JobError> JobManager::submit(SubmitRequest r) {
     return fail(*store_refusal(), &job);
   }
   event(job, "state", {{"from", nullptr}, {"to", "queued"}, {"reason", "submitted"},
-                       {"source", r.move_into_job ? nlohmann::json("upload") : nlohmann::json(r.model_path)}});
+                       {"source", r.move_into_job ? nlohmann::json("upload") : nlohmann::json(r.model_path)},
+                       {"by", r.by.user}, {"role", role_name(r.by.role)}});
   log()->info("job {}: queued ({}, from {})", job.id, job.model_path, r.move_into_job ? "an upload" : r.model_path);
   jobs_[job.id] = job;
   plan_queue_.push_back(job.id);
@@ -286,7 +295,14 @@ std::expected<JobRecord, JobError> JobManager::get(const std::string& id) const 
   return *job;
 }
 
-std::expected<JobRecord, JobError> JobManager::cancel(const std::string& id) {
+std::expected<std::vector<JobEvent>, JobError> JobManager::events(const std::string& id) const {
+  if (!get(id)) return std::unexpected(job_error(JobErrorKind::not_found, fmt::format("no job {}", id)));
+  auto events = store_.events(id);  // the store locks itself: not under mutex_
+  if (!events) return std::unexpected(job_error(JobErrorKind::storage, events.error().message));
+  return std::move(*events);
+}
+
+std::expected<JobRecord, JobError> JobManager::cancel(const std::string& id, const Actor& by) {
   std::shared_ptr<drivers::CutJob> cut;
   JobRecord copy;
   {
@@ -296,6 +312,7 @@ std::expected<JobRecord, JobError> JobManager::cancel(const std::string& id) {
     if (auto refused = store_refusal()) return std::unexpected(*refused);  // machine.abort stops a cut all the same
     if (is_terminal(job->state))
       return std::unexpected(job_error(JobErrorKind::wrong_state, fmt::format("job {} is already {}", id, to_string(job->state))));
+    action(*job, "cancel", by);
     if (job->state == JobState::planning) {
       if (auto it = plan_cancel_.find(id); it != plan_cancel_.end()) it->second->store(true);
       return *job;  // the planner worker marks it cancelled when the child has stopped
@@ -328,7 +345,7 @@ std::expected<JobRecord, JobError> JobManager::cancel(const std::string& id) {
   return copy;
 }
 
-std::expected<JobRecord, JobError> JobManager::confirm_sheet(const std::string& id, int sheet) {
+std::expected<JobRecord, JobError> JobManager::confirm_sheet(const std::string& id, int sheet, const Actor& by) {
   const ProgramRead program = read_current_program(id);
   std::lock_guard lock(mutex_);
   JobRecord* job = find(id);
@@ -339,16 +356,18 @@ std::expected<JobRecord, JobError> JobManager::confirm_sheet(const std::string& 
   if (sheet != job->current_sheet)
     return std::unexpected(job_error(JobErrorKind::bad_request,
                                  fmt::format("sheet {}: job {} waits for sheet {}", sheet, id, job->current_sheet)));
+  action(*job, "confirm_sheet", by, {{"sheet", sheet}});
   if (auto started = start_cut(*job, CutStart::fresh, program); !started) return std::unexpected(started.error());
   return *job;
 }
 
-std::expected<JobRecord, JobError> JobManager::resume(const std::string& id) {
+std::expected<JobRecord, JobError> JobManager::resume(const std::string& id, const Actor& by) {
   const ProgramRead program = read_current_program(id);
   std::lock_guard lock(mutex_);
   JobRecord* job = find(id);
   if (!job) return std::unexpected(job_error(JobErrorKind::not_found, fmt::format("no job {}", id)));
   if (auto refused = store_refusal()) return std::unexpected(*refused);
+  if (job->state == JobState::paused || job->state == JobState::interrupted) action(*job, "resume", by);
   if (job->state == JobState::paused && pause_ == PauseKind::hold && cutting_) {
     std::shared_ptr<drivers::CutJob> cut = cut_;
     cut->continue_motion();  // jet on again first, then the cycle start (line and PLC): CutJob's hold watch
@@ -390,7 +409,7 @@ nlohmann::json JobManager::machine_status() {
 
 // The machine first, the bookkeeping after: the hold reaches the line and the PLC without
 // waiting for the database (a synced write) or for anyone holding the lock.
-std::expected<nlohmann::json, JobError> JobManager::hold() {
+std::expected<nlohmann::json, JobError> JobManager::hold(const Actor& by) {
   std::shared_ptr<drivers::CutJob> cut;
   {
     std::lock_guard lock(mutex_);
@@ -402,29 +421,31 @@ std::expected<nlohmann::json, JobError> JobManager::hold() {
   cut->hold();  // the line's real-time byte and the PLC's button (a drip feed has no hold on its line)
   std::lock_guard lock(mutex_);
   if (JobRecord* job = find(machine_job_); job && job->state == JobState::cutting && cutting_ && cut_ == cut) {
+    action(*job, "hold", by);
     pause_ = PauseKind::hold;
     (void)set_state(*job, JobState::paused, "held by the operator");
   }
   return nlohmann::json{{"held", true}};
 }
 
-std::expected<nlohmann::json, JobError> JobManager::resume_motion() {
+std::expected<nlohmann::json, JobError> JobManager::resume_motion(const Actor& by) {
   std::string id;
   {
     std::lock_guard lock(mutex_);
     id = machine_job_;
   }
   if (id.empty()) return std::unexpected(job_error(JobErrorKind::wrong_state, "no job has the machine"));
-  auto r = resume(id);
+  auto r = resume(id, by);
   if (!r) return std::unexpected(r.error());
   return to_json(*r);
 }
 
-std::expected<nlohmann::json, JobError> JobManager::abort(const std::string& why) {
+std::expected<nlohmann::json, JobError> JobManager::abort(const std::string& why, const Actor& by) {
   std::shared_ptr<drivers::CutJob> cut;
   {
     std::lock_guard lock(mutex_);
     if (!cutting_) return std::unexpected(job_error(JobErrorKind::wrong_state, "nothing is cutting"));
+    if (const JobRecord* job = find(machine_job_)) action(*job, "abort", by, {{"reason", why}});
     cut = cut_;
   }
   cut->abort(why);  // the cut stops safely; its job becomes paused with a resume point

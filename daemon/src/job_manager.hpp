@@ -23,17 +23,25 @@
 #include "lamina/daemon/daemon_config.hpp"
 #include "lamina/daemon/job_model.hpp"
 #include "lamina/daemon/job_store.hpp"
+#include "lamina/daemon/roles.hpp"
 #include "job_error.hpp"
 #include "lamina/drivers/cut_job.hpp"
 #include "machine_session.hpp"
 
 namespace lamina::daemon {
 
+// Who asked for an action, for the job's events: a console login, "unix pid 1 uid 0", "tcp".
+struct Actor {
+  std::string user;
+  Role role = Role::engineer;
+};
+
 struct SubmitRequest {
   std::string model_path;             // as the client named it (inside [jobs] roots), or the upload's file
   std::string name;                   // for people; default: the file name
   nlohmann::json settings = nlohmann::json::object();  // plan settings (plan_settings.hpp)
   bool move_into_job = false;         // an upload: the file moves into the job's folder
+  Actor by;
 };
 
 class JobManager {
@@ -54,14 +62,16 @@ class JobManager {
   std::expected<JobRecord, JobError> submit(SubmitRequest request);
   std::vector<JobRecord> list() const;
   std::expected<JobRecord, JobError> get(const std::string& id) const;
-  std::expected<JobRecord, JobError> cancel(const std::string& id);
-  std::expected<JobRecord, JobError> confirm_sheet(const std::string& id, int sheet);
-  std::expected<JobRecord, JobError> resume(const std::string& id);  // paused or interrupted
+  std::expected<std::vector<JobEvent>, JobError> events(const std::string& id) const;  // oldest first
+  // The operator's and engineer's actions: each is an "action" event of its job, with who.
+  std::expected<JobRecord, JobError> cancel(const std::string& id, const Actor& by);
+  std::expected<JobRecord, JobError> confirm_sheet(const std::string& id, int sheet, const Actor& by);
+  std::expected<JobRecord, JobError> resume(const std::string& id, const Actor& by);  // paused or interrupted
 
   nlohmann::json machine_status();  // checks the database file too
-  std::expected<nlohmann::json, JobError> hold();
-  std::expected<nlohmann::json, JobError> resume_motion();
-  std::expected<nlohmann::json, JobError> abort(const std::string& why);
+  std::expected<nlohmann::json, JobError> hold(const Actor& by);
+  std::expected<nlohmann::json, JobError> resume_motion(const Actor& by);
+  std::expected<nlohmann::json, JobError> abort(const std::string& why, const Actor& by);
 
   std::string status_line() const;  // for sd_notify STATUS=
 
@@ -75,6 +85,7 @@ class JobManager {
   std::optional<JobError> store_refusal() const;      // -32014 while the store has failed
   void reload(JobRecord& job);                        // memory as the database has it
   void event(const JobRecord& job, const std::string& kind, nlohmann::json data);
+  void action(const JobRecord& job, const std::string& what, const Actor& by, nlohmann::json data = nlohmann::json::object());
   void announce(const JobRecord& job);
   void assign_machine();              // the oldest planned job gets the machine when it is free
   JobRecord* find(const std::string& id);

@@ -15,7 +15,6 @@
 namespace lamina::daemon::rpc_detail {
 namespace {
 
-constexpr std::size_t read_chunk_bytes = 64 * 1024;
 // Lines longer than this are parsed on the worker: even valid JSON takes milliseconds per MiB.
 constexpr std::size_t parse_on_worker_bytes = 64 * 1024;
 // Queued for the worker beyond this, the socket is not read until the worker catches up.
@@ -27,14 +26,13 @@ constexpr auto linger_after_refusal = std::chrono::seconds(2);
 
 }  // namespace
 
-Connection::Connection(Socket socket, ClientContext context, std::string peer, std::shared_ptr<ServerShared> shared,
-                       ClosedCallback on_closed)
-    : socket_(std::move(socket)),
-      context_(context),
+Connection::Connection(std::unique_ptr<RpcTransport> transport, ClientContext context, std::string peer,
+                       std::shared_ptr<ServerShared> shared, ClosedCallback on_closed)
+    : transport_(std::move(transport)),
+      context_(std::move(context)),
       peer_(std::move(peer)),
       shared_(std::move(shared)),
-      on_closed_(std::move(on_closed)),
-      chunk_(read_chunk_bytes) {}
+      on_closed_(std::move(on_closed)) {}
 
 bool ServerShared::is_inline(std::string_view method) const {
   for (const auto& m : settings.inline_methods)
@@ -58,7 +56,7 @@ void Connection::arm_idle_timer() {
   const bool pre_auth = context_.via == Via::tcp && !authenticated_;
   const double seconds = pre_auth ? shared_->settings.pre_auth_timeout_s : shared_->settings.idle_timeout_s;
   if (seconds <= 0) return;
-  if (!idle_timer_) idle_timer_.emplace(socket_.get_executor());
+  if (!idle_timer_) idle_timer_.emplace(transport_->executor());
   idle_timer_->expires_after(std::chrono::duration_cast<std::chrono::steady_clock::duration>(
       std::chrono::duration<double>(seconds)));
   idle_timer_->async_wait([self = shared_from_this(), pre_auth, seconds](const boost::system::error_code& error) {
@@ -73,14 +71,13 @@ void Connection::arm_idle_timer() {
 bool Connection::may_close_after_eof() const { return !writing_ && !busy_ && waiting_.empty(); }
 
 void Connection::read_next() {
-  socket_.async_read_some(boost::asio::buffer(chunk_),
-                          [self = shared_from_this()](const boost::system::error_code& error, std::size_t size) {
-                            std::lock_guard lock(self->shared_->mutex);
-                            self->on_read(error, size);
-                          });
+  transport_->async_read([self = shared_from_this()](const boost::system::error_code& error, std::string_view data) {
+    std::lock_guard lock(self->shared_->mutex);
+    self->on_read(error, data);
+  });
 }
 
-void Connection::on_read(const boost::system::error_code& error, std::size_t size) {
+void Connection::on_read(const boost::system::error_code& error, std::string_view data) {
   // A read that completed just before close() still arrives with its data: ignore it.
   if (closed_) return;
   if (error == boost::asio::error::eof && !draining_) {
@@ -102,7 +99,6 @@ void Connection::on_read(const boost::system::error_code& error, std::size_t siz
   // Before its token, a TCP peer gets a few KiB per line, not the MiB a client may send.
   const std::size_t limit = context_.via == Via::tcp && !authenticated_ ? shared_->settings.pre_auth_max_bytes
                                                                 : shared_->settings.max_request_bytes;
-  std::string_view data(chunk_.data(), size);
   while (!closed_ && !draining_) {
     const std::size_t newline = data.find('\n');
     if (newline == std::string_view::npos) {
@@ -219,7 +215,7 @@ void Connection::dispatch_next() {
     }
     // The handler worked on a copy of the client's context: what it changed (a subscription)
     // is applied on the io thread, where broadcasts read it.
-    boost::asio::post(self->socket_.get_executor(), [self, id = std::move(id), notification, result = std::move(result),
+    boost::asio::post(self->transport_->executor(), [self, id = std::move(id), notification, result = std::move(result),
                                                      subscribed = context.subscribed] {
       std::lock_guard lock(self->shared_->mutex);
       self->context_.subscribed = subscribed;
@@ -278,7 +274,7 @@ void Connection::refuse_and_hang_up(std::string line, std::string_view why) {
   waiting_bytes_ = 0;
   send_line(std::move(line));
   if (closed_) return;  // the reply alone passed max_queued_bytes
-  linger_.emplace(socket_.get_executor(), linger_after_refusal);
+  linger_.emplace(transport_->executor(), linger_after_refusal);
   linger_->async_wait([self = shared_from_this(), why = std::string(why)](const boost::system::error_code& error) {
     std::lock_guard lock(self->shared_->mutex);
     if (!error) self->close(fmt::format("did not hang up after: {}", why));
@@ -300,18 +296,14 @@ void Connection::send(std::shared_ptr<const std::string> line) {
 }
 
 void Connection::write_next() {
-  // Everything queued goes out in one gathered write: a pipelining client gets its replies in
-  // few system calls.
+  // Everything queued goes to the transport at once (a socket writes it gathered).
   in_flight_.assign(std::make_move_iterator(queue_.begin()), std::make_move_iterator(queue_.end()));
   queue_.clear();
-  buffers_.clear();
-  for (const auto& line : in_flight_) buffers_.push_back(boost::asio::buffer(*line));
   writing_ = true;
-  boost::asio::async_write(socket_, buffers_,
-                           [self = shared_from_this()](const boost::system::error_code& error, std::size_t) {
-                             std::lock_guard lock(self->shared_->mutex);
-                             self->on_write(error);
-                           });
+  transport_->async_write(in_flight_, [self = shared_from_this()](const boost::system::error_code& error) {
+    std::lock_guard lock(self->shared_->mutex);
+    self->on_write(error);
+  });
 }
 
 void Connection::on_write(const boost::system::error_code& error) {
@@ -330,8 +322,7 @@ void Connection::on_write(const boost::system::error_code& error) {
   } else if (draining_ && !peer_done_) {
     // The refusal is out: half-close so the client sees EOF, and keep discarding its input until
     // it hangs up too (or linger_ expires).
-    boost::system::error_code ignored;
-    socket_.shutdown(Socket::shutdown_send, ignored);
+    transport_->shutdown_send();
   }
 }
 
@@ -342,8 +333,7 @@ void Connection::close(std::string_view reason) {
   shared_->log->debug("client {} ({}) closed: {}", context_.id, peer_, reason);
   // Before the socket closes: whoever sees the EOF must find the client gone from the count.
   if (auto on_closed = std::exchange(on_closed_, nullptr)) on_closed(context_.id);
-  boost::system::error_code ignored;
-  socket_.close(ignored);  // pending operations complete with operation_aborted
+  transport_->close();  // pending operations complete with operation_aborted
   if (linger_) linger_->cancel();
   if (idle_timer_) idle_timer_->cancel();
   queue_.clear();

@@ -1,5 +1,6 @@
 #pragma once
-// One client of rpc_server: reads newline-delimited requests, runs the handler, queues replies.
+// One client of rpc_server: reads newline-delimited requests, runs the handler, queues replies,
+// over whichever RpcTransport it came through (a Unix or TCP socket, a WebSocket).
 // Used by rpc_server.cpp only; the server owns connections through shared_ptr and every
 // completion handler holds one too, so a connection outlives any operation still in flight.
 #include <chrono>
@@ -14,13 +15,12 @@
 #include <string_view>
 #include <vector>
 
-#include <boost/asio/buffer.hpp>
-#include <boost/asio/generic/stream_protocol.hpp>
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/steady_timer.hpp>
 #include <spdlog/logger.h>
 
 #include "lamina/daemon/rpc_server.hpp"
+#include "rpc_transport.hpp"
 
 namespace lamina::daemon::rpc_detail {
 
@@ -43,11 +43,9 @@ struct ServerShared {
 
 class Connection : public std::enable_shared_from_this<Connection> {
  public:
-  // Unix and TCP clients share one socket type: the code below does not care which it is.
-  using Socket = boost::asio::generic::stream_protocol::socket;
   using ClosedCallback = std::function<void(std::uint64_t client_id)>;
 
-  Connection(Socket socket, ClientContext context, std::string peer, std::shared_ptr<ServerShared> shared,
+  Connection(std::unique_ptr<RpcTransport> transport, ClientContext context, std::string peer, std::shared_ptr<ServerShared> shared,
              ClosedCallback on_closed);
   Connection(const Connection&) = delete;
   Connection& operator=(const Connection&) = delete;
@@ -73,7 +71,7 @@ class Connection : public std::enable_shared_from_this<Connection> {
   };
 
   void read_next();
-  void on_read(const boost::system::error_code& error, std::size_t size);
+  void on_read(const boost::system::error_code& error, std::string_view data);
   void handle_line(std::string_view line);
   std::optional<RpcRequest> accept_request(std::string_view line);  // parsed and authorised, or replied to
   void dispatch_next();
@@ -87,18 +85,16 @@ class Connection : public std::enable_shared_from_this<Connection> {
   void write_next();
   void on_write(const boost::system::error_code& error);
 
-  Socket socket_;
+  std::unique_ptr<RpcTransport> transport_;
   ClientContext context_;
   std::string peer_;  // for the log: "unix pid 123 uid 1000" or "tcp 127.0.0.1:51234"
   std::shared_ptr<ServerShared> shared_;
   ClosedCallback on_closed_;
 
-  std::vector<char> chunk_;  // one read's worth
   std::string partial_;      // the start of a line whose '\n' has not arrived yet
 
   std::deque<std::shared_ptr<const std::string>> queue_;  // broadcasts share one string
-  std::vector<std::shared_ptr<const std::string>> in_flight_;
-  std::vector<boost::asio::const_buffer> buffers_;  // into in_flight_, for one gathered write
+  std::vector<std::shared_ptr<const std::string>> in_flight_;  // alive until the write's handler
   std::size_t queued_bytes_ = 0;                    // queue_ and in_flight_ together
   bool writing_ = false;
 

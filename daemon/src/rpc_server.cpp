@@ -37,6 +37,7 @@
 
 #include "rpc_connection.hpp"
 #include "rpc_protocol.hpp"
+#include "rpc_transport.hpp"
 
 namespace lamina::daemon {
 namespace {
@@ -248,18 +249,20 @@ struct RpcServer::Impl : std::enable_shared_from_this<RpcServer::Impl> {
     }
     accept_next(acceptor, via);
     std::string peer;
+    std::string user = "tcp";
     if constexpr (std::is_same_v<typename Socket::protocol_type, tcp>) {
       boost::system::error_code ignored;
       socket.set_option(tcp::no_delay(true), ignored);  // replies are small and awaited
       peer = tcp_peer(socket);
     } else {
       peer = unix_peer(socket.native_handle());
+      user = peer;
     }
     if (count(via) >= settings().max_clients && !evict_one(via)) {
       refuse(socket, peer, via);
       return;
     }
-    admit(std::move(socket), via, std::move(peer));
+    admit(std::move(socket), via, std::move(peer), std::move(user));
   }
 
   std::size_t count(Via via) const {
@@ -298,8 +301,8 @@ struct RpcServer::Impl : std::enable_shared_from_this<RpcServer::Impl> {
   }
 
   template <typename Socket>
-  void admit(Socket socket, Via via, std::string peer) {
-    // One socket type for both kinds of client (see Connection::Socket).
+  void admit(Socket socket, Via via, std::string peer, std::string user) {
+    // One socket type for both kinds of client: the transport does not care which it is.
     boost::system::error_code error;
     const boost::asio::generic::stream_protocol protocol(socket.local_endpoint(error).protocol());
     const int fd = socket.release(error);
@@ -307,16 +310,20 @@ struct RpcServer::Impl : std::enable_shared_from_this<RpcServer::Impl> {
       log().warn("cannot take over the socket of {}: {}", peer, error.message());
       return;
     }
-    Connection::Socket generic(io);
+    boost::asio::generic::stream_protocol::socket generic(io);
     generic.assign(protocol, fd, error);
     if (error) {
       ::close(fd);
       log().warn("cannot take over the socket of {}: {}", peer, error.message());
       return;
     }
-    const ClientContext context{next_client_id++, via, false};
+    start_connection(make_stream_transport(std::move(generic)),
+                     ClientContext{next_client_id++, via, false, std::move(user), Role::engineer}, std::move(peer));
+  }
+
+  void start_connection(std::unique_ptr<RpcTransport> transport, ClientContext context, std::string peer) {
     auto connection = std::make_shared<Connection>(
-        std::move(generic), context, std::move(peer), shared, [weak = weak_from_this()](std::uint64_t id) {
+        std::move(transport), context, std::move(peer), shared, [weak = weak_from_this()](std::uint64_t id) {
           // Runs inside Connection::close, under the lock.
           if (auto self = weak.lock()) {
             self->connections.erase(id);
@@ -426,7 +433,30 @@ void RpcServer::stop() {
   impl_->stop("server stopping");
 }
 
-const char* via_name(Via via) { return via == Via::tcp ? "TCP" : "Unix"; }
+std::expected<void, std::string> RpcServer::adopt(std::unique_ptr<RpcTransport> transport, Via via, std::string user,
+                                                  Role role, std::string peer) {
+  std::lock_guard lock(impl_->shared->mutex);
+  if (impl_->stopped) return std::unexpected(std::string("the server is stopping"));
+  if (impl_->count(via) >= impl_->settings().max_clients && !impl_->evict_one(via)) {
+    impl_->log().warn("refusing {}: {} {} clients connected, none idle (max_clients)", peer, impl_->count(via),
+                      via_name(via));
+    return std::unexpected(fmt::format("too many {} clients (limit {}, none idle)", via_name(via),
+                                       impl_->settings().max_clients));
+  }
+  impl_->start_connection(std::move(transport), ClientContext{impl_->next_client_id++, via, false, std::move(user), role},
+                          std::move(peer));
+  return {};
+}
+
+const char* via_name(Via via) {
+  switch (via) {
+    case Via::tcp: return "TCP";
+    case Via::websocket: return "WebSocket";
+    case Via::unix_socket: break;
+  }
+  return "Unix";
+}
+
 
 std::size_t RpcServer::client_count() const { return impl_->clients.load(); }
 

@@ -57,6 +57,26 @@ inline std::string body_of(const std::string& response) {
   return at == std::string::npos ? "" : response.substr(at + 4);
 }
 
+inline std::string http_post(int port, const std::string& target, const std::string& body, const std::string& extra = "") {
+  return http_exchange(port, "POST " + target + " HTTP/1.1\r\nHost: localhost:" + std::to_string(port) +
+                                 "\r\nContent-Type: application/json\r\nContent-Length: " + std::to_string(body.size()) +
+                                 "\r\n" + extra + "Connection: close\r\n\r\n" + body);
+}
+
+// "lamina_session=…" from a login's Set-Cookie header (empty when there is none).
+inline std::string session_cookie(const std::string& response) {
+  const auto at = response.find("Set-Cookie: ");
+  if (at == std::string::npos) return {};
+  const auto end = response.find(';', at);
+  return response.substr(at + 12, end - at - 12);
+}
+
+// Logs in; the cookie, or empty when refused. (The password is plain text: no JSON escaping.)
+inline std::string http_login(int port, const std::string& user, const std::string& password) {
+  return session_cookie(
+      http_post(port, "/api/login", "{\"user\": \"" + user + "\", \"password\": \"" + password + "\"}"));
+}
+
 // A port nobody listens on right now (the kernel's pick, released again).
 inline int free_loopback_port() {
   const int fd = ::socket(AF_INET, SOCK_STREAM, 0);

@@ -16,6 +16,7 @@ namespace fs = std::filesystem;
 using lamina::daemon::DaemonConfig;
 using lamina::daemon::load_daemon_config;
 using lamina::daemon::parse_daemon_config;
+using lamina::daemon::Role;
 
 const fs::path kSource = LAMINA_SOURCE_DIR;
 
@@ -68,6 +69,10 @@ void expect_same(const DaemonConfig& a, const DaemonConfig& b) {
   EXPECT_EQ(a.http.static_dir, b.http.static_dir);
   EXPECT_EQ(a.http.idle_timeout_s, b.http.idle_timeout_s);
   EXPECT_EQ(a.http.max_connections, b.http.max_connections);
+  EXPECT_EQ(a.http.users.size(), b.http.users.size());
+  EXPECT_EQ(a.http.session_hours, b.http.session_hours);
+  EXPECT_EQ(a.http.server_names, b.http.server_names);
+  EXPECT_EQ(a.http.allowed_origins, b.http.allowed_origins);
   EXPECT_EQ(a.link.protocol, b.link.protocol);
   EXPECT_EQ(a.link.port, b.link.port);
   EXPECT_EQ(a.link.tcp, b.link.tcp);
@@ -118,7 +123,7 @@ TEST(DaemonConfig, TheDefaultsFileShowsEveryKey) {
                           "abrasive_g_per_min", "hold_limit_s", "jet_restart_s", "lamina", "workers", "machine",
                           "materials", "timeout_s", "memory_limit_mb", "cpu_limit_s", "nice", "roots",
                           "max_model_bytes", "max_stock_file_bytes", "upload_idle_s", "max_uploads", "listen",
-                          "static_dir", "max_connections"})
+                          "static_dir", "max_connections", "session_hours", "server_names", "allowed_origins"})
     EXPECT_NE(text.find(std::string("\n") + key + " = "), std::string::npos) << key;
 }
 
@@ -159,7 +164,7 @@ TEST(DaemonConfig, JobsRoots) {
 
 // The web console (issue 19): on at 127.0.0.1:8080 unless turned off; another machine may reach
 // it only once it has users and logins, which it has not yet.
-TEST(DaemonConfig, TheWebConsoleListensOnLoopbackOnly) {
+TEST(DaemonConfig, TheWebConsoleListensOnLoopbackOnlyWithoutUsers) {
   auto on = parse_daemon_config("[http]\nlisten = \"127.0.0.1:9090\"\nstatic_dir = \"web\"\n", "/etc/lamina/x.toml");
   ASSERT_TRUE(on.has_value()) << on.error().message;
   EXPECT_EQ(on->http.host, "127.0.0.1");
@@ -169,9 +174,49 @@ TEST(DaemonConfig, TheWebConsoleListensOnLoopbackOnly) {
   ASSERT_TRUE(off.has_value()) << off.error().message;
   EXPECT_FALSE(off->http.host);
   const std::string wide = error_of("[http]\nlisten = \"0.0.0.0:8080\"\n");
-  EXPECT_NE(wide.find("test.toml:2: [http] listen: 0.0.0.0 is not a loopback address"), std::string::npos) << wide;
+  EXPECT_NE(wide.find("test.toml:2: [http] listen: 0.0.0.0 is not a loopback address; without [[http.users]]"),
+            std::string::npos)
+      << wide;
   EXPECT_NE(error_of("[http]\nlisten = \"8080\"\n").find("[http] listen: expected \"HOST:PORT\""), std::string::npos);
   EXPECT_NE(error_of("[http]\nmax_connections = 0\n").find("[http] max_connections"), std::string::npos);
+}
+
+const std::string kHash = "$argon2id$v=19$m=65536,t=2,p=1$Bcj9sax4waBzCIk+PcmmHg$O43CmjaxoLxIl9IsDJlYts+dL6q/p/tqaSwAspBVZ5c";
+
+std::string user_entry(const std::string& name, const std::string& role, const std::string& hash = kHash) {
+  return "[[http.users]]\nname = \"" + name + "\"\nrole = \"" + role + "\"\npassword_hash = \"" + hash + "\"\n";
+}
+
+TEST(DaemonConfig, WebUsersLetTheConsoleListenOnAnyAddress) {
+  auto c = parse_daemon_config("[http]\nlisten = \"0.0.0.0:8080\"\nsession_hours = 8\nserver_names = [\"cell-7\"]\n" +
+                                   user_entry("ana", "operator") + user_entry("eng", "engineer") +
+                                   user_entry("vic", "viewer"),
+                               "x.toml");
+  ASSERT_TRUE(c.has_value()) << c.error().message;
+  EXPECT_EQ(c->http.host, "0.0.0.0");
+  ASSERT_EQ(c->http.users.size(), 3U);
+  EXPECT_EQ(c->http.users[0].name, "ana");
+  EXPECT_EQ(c->http.users[0].role, Role::machine_operator);
+  EXPECT_EQ(c->http.users[1].role, Role::engineer);
+  EXPECT_EQ(c->http.users[2].role, Role::viewer);
+  EXPECT_EQ(c->http.users[0].password_hash, kHash);
+  EXPECT_EQ(c->http.session_hours, 8);
+  EXPECT_EQ(c->http.server_names, std::vector<std::string>{"cell-7"});
+}
+
+TEST(DaemonConfig, AWebUserWithAWrongRoleHashOrNameIsAnErrorAtItsLine) {
+  const std::string role = error_of("[http]\n" + user_entry("ana", "admin"));
+  EXPECT_NE(role.find("test.toml:4: [http.users] role: \"admin\" is not one of viewer, operator, engineer"),
+            std::string::npos)
+      << role;
+  const std::string plain = error_of("[http]\n" + user_entry("ana", "operator", "hunter2"));
+  EXPECT_NE(plain.find("[http.users] password_hash: expected an Argon2id hash"), std::string::npos) << plain;
+  const std::string twice = error_of("[http]\n" + user_entry("ana", "operator") + user_entry("ana", "viewer"));
+  EXPECT_NE(twice.find("test.toml:7: [http.users] name: 'ana' is named twice"), std::string::npos) << twice;
+  const std::string blank = error_of("[http]\n" + user_entry("a b", "viewer"));
+  EXPECT_NE(blank.find("[http.users] name: expected a name"), std::string::npos) << blank;
+  const std::string key = error_of("[http]\n[[http.users]]\nname = \"x\"\nrole = \"viewer\"\npassword = \"p\"\n");
+  EXPECT_NE(key.find("[http.users] password: unknown key (known: name, role, password_hash)"), std::string::npos) << key;
 }
 
 TEST(DaemonConfig, AnEmptyFileKeepsTheDefaults) {

@@ -77,6 +77,15 @@ TEST(HttpRoutes, TheConsolesFilesAreSafeRelativePaths) {
   EXPECT_TRUE(std::holds_alternative<WebSocketRequest>(*route_get("/ws")));
 }
 
+TEST(HttpRoutes, TheSessionAndTheLoginHaveTheirOwnPaths) {
+  EXPECT_TRUE(std::holds_alternative<SessionRequest>(*route_get("/api/session")));
+  EXPECT_EQ(route_get("/api/session/x").error().status, 404);
+  EXPECT_EQ(*route_post("/api/login"), PostRoute::login);
+  EXPECT_EQ(*route_post("/api/logout"), PostRoute::logout);
+  for (const char* other : {"/api/login/", "/api/login?x=1", "/api/jobs", "/", "/api/../api/login"})
+    EXPECT_EQ(route_post(other).error().status, 404) << other;
+}
+
 TEST(HttpRoutes, ContentTypesFollowTheExtension) {
   EXPECT_EQ(content_type("index.html"), "text/html; charset=utf-8");
   EXPECT_EQ(content_type("sheet-1.svg"), "image/svg+xml");

@@ -49,7 +49,7 @@ struct Web {
       const auto p = job_dir / artefact_file_name(r);
       if (!std::filesystem::exists(p)) return std::unexpected(RouteError{404, "not yet written"});
       return p;
-    });
+    }, nullptr);
     auto ok = server->listen();
     if (!ok) throw std::runtime_error(ok.error());
     thread = std::thread([this] { io.run(); });
@@ -105,14 +105,18 @@ TEST(HttpServer, ASymlinkOutOfTheConsolesFolderIsNotFollowed) {
   EXPECT_EQ(r.find("secret"), std::string::npos);
 }
 
-TEST(HttpServer, OnlyGetAndHeadAreServed) {
+TEST(HttpServer, OnlyGetAndHeadAreServedAndPostOnlyForTheLogin) {
   Web web;
-  const std::string del = exchange(web.port(), "DELETE / HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n");
+  const std::string del = exchange(web.port(), "DELETE / HTTP/1.1\r\nHost: localhost\r\nConnection: close\r\n\r\n");
   EXPECT_EQ(status_of(del), 405) << del;
-  EXPECT_NE(del.find("Allow: GET, HEAD"), std::string::npos) << del;
-  const std::string post = exchange(web.port(), "POST / HTTP/1.1\r\nHost: x\r\nContent-Length: 5\r\n\r\nhello");
-  EXPECT_EQ(status_of(post), 413) << post;
-  const std::string head = exchange(web.port(), "HEAD / HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n");
+  EXPECT_NE(del.find("Allow: GET, HEAD, POST"), std::string::npos) << del;
+  const std::string post = exchange(web.port(), "POST / HTTP/1.1\r\nHost: localhost\r\nContent-Length: 5\r\nConnection: close\r\n\r\nhello");
+  EXPECT_EQ(status_of(post), 404) << post;
+  const std::string big = exchange(web.port(), "POST /api/login HTTP/1.1\r\nHost: localhost\r\nContent-Length: 5000\r\n\r\n" + std::string(5000, 'a'));
+  EXPECT_EQ(status_of(big), 413) << big;
+  const std::string body = exchange(web.port(), "GET / HTTP/1.1\r\nHost: localhost\r\nContent-Length: 5\r\n\r\nhello");
+  EXPECT_EQ(status_of(body), 413) << body;
+  const std::string head = exchange(web.port(), "HEAD / HTTP/1.1\r\nHost: localhost\r\nConnection: close\r\n\r\n");
   EXPECT_EQ(status_of(head), 200) << head;
   EXPECT_NE(head.find("Content-Length: 36"), std::string::npos) << head;
   EXPECT_EQ(body_of(head), "");
@@ -127,8 +131,8 @@ TEST(HttpServer, AnOversizedRequestHeadIsRefused) {
 TEST(HttpServer, KeepAliveServesSeveralRequestsOnOneConnection) {
   Web web;
   const std::string two = exchange(web.port(),
-                                   "GET /assets/app.js HTTP/1.1\r\nHost: x\r\n\r\n"
-                                   "GET / HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n");
+                                   "GET /assets/app.js HTTP/1.1\r\nHost: localhost\r\n\r\n"
+                                   "GET / HTTP/1.1\r\nHost: localhost\r\nConnection: close\r\n\r\n");
   EXPECT_NE(two.find("console.log('lamina');"), std::string::npos) << two;
   EXPECT_NE(two.find("<title>Lamina</title>"), std::string::npos) << two;
 }

@@ -10,7 +10,9 @@
 #include <fstream>
 
 #include "daemon_fixture.hpp"
+#include "http/passwords.hpp"
 #include "http_test_client.hpp"
+#include "ws_test_client.hpp"
 
 namespace lamina::daemon::testing {
 namespace {
@@ -56,6 +58,56 @@ TEST(LaminadWeb, APlannedJobsArtefactsAreServedAsTheyAreInItsFolder) {
     EXPECT_TRUE(r.starts_with("HTTP/1.1 400") || r.starts_with("HTTP/1.1 404")) << attack << ": " << r.substr(0, 200);
     EXPECT_EQ(r.find("SQLite format"), std::string::npos) << attack;
   }
+}
+
+std::string web_user(const std::string& name, const std::string& role, const std::string& password) {
+  return fmt::format("[[http.users]]\nname = \"{}\"\nrole = \"{}\"\npassword_hash = \"{}\"\n", name, role,
+                     *http::hash_password(password));
+}
+
+// The roles on the real methods, through the browser's path (login, WebSocket), and who did what
+// in the job's events.
+TEST(LaminadWeb, AViewerIsRefusedOutLoudAndAnOperatorsConfirmIsInTheJobsEvents) {
+  Cell cell;
+  const int port = free_loopback_port();
+  Laminad daemon(cell.config("", fmt::format("listen = \"127.0.0.1:{}\"\n{}{}", port, web_user("vic", "viewer", "v-pass"),
+                                             web_user("ana", "operator", "a-pass"))),
+                 cell.dir.file(""));
+  RpcClient c = connect(cell.socket());
+  Json job = call_ok(c, "job.submit", {{"model", std::string(LAMINA_EXAMPLES_DIR) + "/knob.stl"}, {"settings", {{"stock", "5"}}}});
+  const std::string id = job["id"];
+  job = wait_state(c, id, "waiting_sheet", 120);
+  ASSERT_EQ(job["state"], "waiting_sheet") << job.dump(2) << daemon.log();
+  const std::string origin = fmt::format("http://localhost:{}", port);
+
+  WsClient viewer(port, http_login(port, "vic", "v-pass"), origin);
+  ASSERT_TRUE(viewer.open()) << viewer.status() << " " << viewer.refusal() << daemon.log();
+  EXPECT_EQ(viewer.call("job.list")["result"].size(), 1U) << "a viewer sees the queue";
+  const Json refused = viewer.call("job.confirm_sheet", {{"job", id}, {"sheet", 1}});
+  ASSERT_TRUE(refused.contains("error")) << refused.dump();
+  EXPECT_EQ(refused["error"]["code"], rpc_code::forbidden);
+  EXPECT_EQ(refused["error"]["message"], "job.confirm_sheet is for an operator or above; vic is a viewer");
+  for (const char* method : {"machine.hold", "machine.abort", "job.cancel", "job.submit", "upload.begin"})
+    EXPECT_EQ(viewer.call(method, {{"job", id}})["error"]["code"], rpc_code::forbidden) << method;
+
+  WsClient op(port, http_login(port, "ana", "a-pass"), origin);
+  ASSERT_TRUE(op.open());
+  EXPECT_EQ(op.call("job.cancel", {{"job", id}})["error"]["code"], rpc_code::forbidden) << "cancel is an engineer's";
+  const Json confirmed = op.call("job.confirm_sheet", {{"job", id}, {"sheet", 1}});
+  ASSERT_TRUE(confirmed.contains("result")) << confirmed.dump() << daemon.log();
+
+  const Json events = op.call("job.events", {{"job", id}})["result"];
+  ASSERT_TRUE(events.is_array()) << events.dump();
+  bool submitted_by_socket = false, confirmed_by_ana = false;
+  for (const Json& e : events) {
+    if (e["kind"] == "state" && e["data"]["to"] == "queued")
+      submitted_by_socket = e["data"]["by"].get<std::string>().starts_with("unix pid") && e["data"]["role"] == "engineer";
+    if (e["kind"] == "action" && e["data"]["action"] == "confirm_sheet")
+      confirmed_by_ana = e["data"]["by"] == "ana" && e["data"]["role"] == "operator" && e["data"]["sheet"] == 1;
+  }
+  EXPECT_TRUE(submitted_by_socket) << events.dump(1);
+  EXPECT_TRUE(confirmed_by_ana) << events.dump(1);
+  call_ok(c, "job.cancel", {{"job", id}});
 }
 
 TEST(LaminadWeb, APortThatIsTakenStopsTheStartNamingIt) {

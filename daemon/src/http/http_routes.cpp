@@ -87,6 +87,7 @@ std::expected<Route, RouteError> route_get(std::string_view target) {
   const auto& s = *segments;
   if (s.size() == 1 && s[0] == "ws") return WebSocketRequest{};
   if (!s.empty() && s[0] == "api") {
+    if (s.size() == 2 && s[1] == "session") return SessionRequest{};
     if (s.size() == 4 && s[1] == "jobs") {
       auto a = artefact(s[2], s[3]);
       if (!a) return std::unexpected(a.error());
@@ -98,6 +99,12 @@ std::expected<Route, RouteError> route_get(std::string_view target) {
   for (const auto& segment : s) relative += (relative.empty() ? "" : "/") + std::string(segment);
   if (s.empty() || path.back() == '/') relative += relative.empty() ? "index.html" : "/index.html";
   return StaticRequest{relative};
+}
+
+std::expected<PostRoute, RouteError> route_post(std::string_view target) {
+  if (target == "/api/login") return PostRoute::login;
+  if (target == "/api/logout") return PostRoute::logout;
+  return std::unexpected(RouteError{404, "POST is served at /api/login and /api/logout only"});
 }
 
 std::string artefact_file_name(const ArtefactRequest& request) {

@@ -1,7 +1,7 @@
 #pragma once
 // What a browser may GET from laminad's web server, decided from the request target alone
 // (sans-IO, tested string by string): a job's artefact, the WebSocket, or a file of the web
-// console. No part of a target reaches the filesystem unchecked: a path is a list of plain
+// console (and POST: the login). No part of a target reaches the filesystem unchecked: a path is a list of plain
 // segments ([A-Za-z0-9._-], no "." or "..", none hidden), percent-encoding is refused rather
 // than decoded, and an artefact is a name from a fixed list, never a path.
 #include <cstdint>
@@ -20,10 +20,13 @@ struct ArtefactRequest {  // GET /api/jobs/<job id>/<name>
   int sheet = 0;  // 1-based, for the sheet's drawing and program
 };
 struct WebSocketRequest {};  // GET /ws (an upgrade)
+struct SessionRequest {};    // GET /api/session: who the cookie says is here
 struct StaticRequest {       // anything else: a file of the console ("/" is index.html)
   std::string relative;      // segments joined by '/', safe to append to the static folder
 };
-using Route = std::variant<ArtefactRequest, WebSocketRequest, StaticRequest>;
+using Route = std::variant<ArtefactRequest, WebSocketRequest, SessionRequest, StaticRequest>;
+
+enum class PostRoute : std::uint8_t { login, logout };  // POST /api/login, /api/logout
 
 struct RouteError {
   int status = 400;  // HTTP status: 400 (malformed), 404 (no such thing)
@@ -31,6 +34,7 @@ struct RouteError {
 };
 
 std::expected<Route, RouteError> route_get(std::string_view target);
+std::expected<PostRoute, RouteError> route_post(std::string_view target);
 
 // The artefact's file name in the job's folder ("sheet-2.svg"); the model is the job's own path.
 std::string artefact_file_name(const ArtefactRequest& request);

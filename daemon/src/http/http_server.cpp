@@ -2,6 +2,7 @@
 #include "http/http_server.hpp"
 
 #include <atomic>
+#include <cmath>
 #include <map>
 
 #include <boost/asio/dispatch.hpp>
@@ -9,8 +10,14 @@
 #include <boost/asio/post.hpp>
 #include <boost/beast/core.hpp>
 #include <boost/beast/http.hpp>
+#include <boost/beast/websocket.hpp>
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 #include <spdlog/spdlog.h>
+
+#include "http/password_checker.hpp"
+#include "http/passwords.hpp"
+#include "http/websocket_transport.hpp"
 
 namespace lamina::daemon::http {
 
@@ -22,6 +29,12 @@ using tcp = asio::ip::tcp;
 namespace {
 
 class Session;
+
+constexpr std::size_t kMaxLoginBody = 4096;
+
+double now_s() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
 
 // Headers every answer carries: the console is its own origin and nothing is cached stale (a
 // job's drawing changes when it is planned again).
@@ -37,12 +50,25 @@ void common_headers(Response& res) {
 }  // namespace
 
 struct HttpServer::Impl : std::enable_shared_from_this<HttpServer::Impl> {
-  Impl(asio::io_context& io_context, HttpSettings s, ArtefactLookup lookup)
-      : io(io_context), settings(std::move(s)), artefacts(std::move(lookup)), acceptor(io_context) {}
+  Impl(asio::io_context& io_context, HttpSettings s, ArtefactLookup lookup, WebSocketHandoff ws)
+      : io(io_context),
+        settings(std::move(s)),
+        artefacts(std::move(lookup)),
+        websockets(std::move(ws)),
+        access(settings.access),
+        acceptor(io_context) {
+    // Unknown names are checked against this, so that a wrong name costs what a wrong password
+    // does (no user list by timing).
+    if (access.users_configured()) dummy_hash = hash_password(random_token()).value_or("");
+  }
 
   asio::io_context& io;
   HttpSettings settings;
   ArtefactLookup artefacts;
+  WebSocketHandoff websockets;
+  WebAccess access;                                        // io thread
+  PasswordChecker passwords;
+  std::string dummy_hash;
   tcp::acceptor acceptor;
   int bound_port = 0;
   bool stopped = false;                                    // io thread
@@ -60,7 +86,12 @@ namespace {
 class Session : public std::enable_shared_from_this<Session> {
  public:
   Session(tcp::socket socket, std::shared_ptr<HttpServer::Impl> server, std::uint64_t id)
-      : stream_(std::move(socket)), server_(std::move(server)), id_(id) {}
+      : stream_(std::move(socket)), server_(std::move(server)), id_(id) {
+    beast::error_code ec;
+    const auto remote = stream_.socket().remote_endpoint(ec);
+    address_ = ec ? "unknown" : remote.address().to_string();
+    peer_ = ec ? "unknown" : fmt::format("{}:{}", address_, remote.port());
+  }
 
   void start() { read_next(); }
   void close() {
@@ -80,10 +111,21 @@ class Session : public std::enable_shared_from_this<Session> {
   void read_next() {
     parser_.emplace();
     parser_->header_limit(static_cast<std::uint32_t>(server_->settings.max_header_bytes));
-    parser_->body_limit(0);  // GET and HEAD only (uploads go over the RPC methods)
+    parser_->body_limit(kMaxLoginBody);  // checked against Content-Length as the head ends
     stream_.expires_after(idle());
+    bhttp::async_read_header(stream_, buffer_, *parser_,
+                             [self = shared_from_this()](beast::error_code ec, std::size_t) { self->on_header(ec); });
+  }
+
+  // Only the login has a body (a few hundred bytes of JSON); anything else with one is refused.
+  void on_header(beast::error_code ec) {
+    if (ec) return on_read(ec);
+    const bool post = parser_->get().method() == bhttp::verb::post;
+    const auto length = parser_->content_length();
+    if (!post && ((length && *length > 0) || parser_->chunked())) return on_read(bhttp::error::body_limit);
+    parser_->body_limit(post ? kMaxLoginBody : 0);  // a chunked body is counted as it comes
     bhttp::async_read(stream_, buffer_, *parser_,
-                      [self = shared_from_this()](beast::error_code ec, std::size_t) { self->on_read(ec); });
+                      [self = shared_from_this()](beast::error_code e, std::size_t) { self->on_read(e); });
   }
 
   void on_read(beast::error_code ec) {
@@ -93,26 +135,139 @@ class Session : public std::enable_shared_from_this<Session> {
     const auto& req = parser_->get();
     keep_alive_ = req.keep_alive();
     head_only_ = req.method() == bhttp::verb::head;
+    if (auto host = server_->access.check_host(field(bhttp::field::host)); !host) return refuse(host.error());
+    if (req.method() == bhttp::verb::post) return on_post();
     if (req.method() != bhttp::verb::get && !head_only_)
-      return send_text(bhttp::status::method_not_allowed, fmt::format("{} is not served here\n", std::string(req.method_string())), keep_alive_, "GET, HEAD");
+      return send_text(bhttp::status::method_not_allowed, fmt::format("{} is not served here\n", std::string(req.method_string())), keep_alive_, "GET, HEAD, POST");
     auto route = route_get(std::string_view(req.target().data(), req.target().size()));
-    if (!route) return send_text(static_cast<bhttp::status>(route.error().status), route.error().message + "\n", keep_alive_);
+    if (!route) return refuse(route.error());
     std::visit([&](const auto& r) { serve(r); }, *route);
   }
 
+  std::string_view field(bhttp::field name) const {
+    const auto& req = parser_->get();
+    const auto it = req.find(name);
+    return it == req.end() ? std::string_view{} : std::string_view(it->value().data(), it->value().size());
+  }
+
+  void refuse(const RouteError& e) {
+    send_text(static_cast<bhttp::status>(e.status), e.message + "\n", keep_alive_);
+  }
+
+  std::expected<Visitor, RouteError> visitor() { return server_->access.visitor(field(bhttp::field::cookie), now_s()); }
+
   void serve(const WebSocketRequest&) {
-    send_text(bhttp::status::not_implemented, "the WebSocket is not served yet\n", keep_alive_);
+    if (auto origin = server_->access.check_origin(field(bhttp::field::origin), field(bhttp::field::host)); !origin)
+      return refuse(origin.error());
+    auto who = visitor();
+    if (!who) return refuse(who.error());
+    if (!beast::websocket::is_upgrade(parser_->get()))
+      return send_text(bhttp::status::upgrade_required, "/ws is a WebSocket\n", keep_alive_);
+    auto ws = std::make_shared<WebSocket>(std::move(stream_));
+    beast::get_lowest_layer(*ws).expires_never();  // the WebSocket keeps its own time (pings)
+    set_websocket_timeouts(*ws, server_->settings.idle_timeout_s);
+    ws->async_accept(parser_->get(), [self = shared_from_this(), ws, who = *who](beast::error_code ec) {
+      self->on_upgraded(ec, ws, who);
+    });
+  }
+
+  void on_upgraded(beast::error_code ec, const std::shared_ptr<WebSocket>& ws, const Visitor& who) {
+    const std::string peer = peer_;
+    finish_counting();  // the WebSocket is the RPC server's client now, counted there
+    if (ec) return spdlog::info("http: WebSocket handshake with {} failed: {}", peer, ec.message());
+    if (!server_->websockets) return;
+    auto adopted = server_->websockets(make_websocket_transport(std::move(*ws), server_->settings.max_request_bytes), who,
+                                       fmt::format("websocket {} {}", peer, who.user));
+    if (!adopted) spdlog::warn("http: WebSocket of {} ({}) refused: {}", who.user, peer, adopted.error());
+  }
+
+  void serve(const SessionRequest&) {
+    auto who = visitor();
+    if (!who) return send_json(static_cast<bhttp::status>(who.error().status), {{"error", who.error().message}});
+    send_json(bhttp::status::ok, {{"user", who->user}, {"role", role_name(who->role)}, {"logged_in", who->logged_in},
+                                  {"users_configured", server_->access.users_configured()}});
   }
   void serve(const StaticRequest& r) {
     if (server_->settings.static_dir.empty()) return send_text(bhttp::status::not_found, "no console files are configured\n", keep_alive_);
     auto path = resolve_static(server_->settings.static_dir, r);
-    if (!path) return send_text(static_cast<bhttp::status>(path.error().status), path.error().message + "\n", keep_alive_);
+    if (!path) return refuse(path.error());
     send_file(*path, content_type(r.relative));
   }
   void serve(const ArtefactRequest& r) {
+    if (auto who = visitor(); !who) return refuse(who.error());
     auto path = server_->artefacts ? server_->artefacts(r) : std::unexpected(RouteError{404, "no jobs here"});
-    if (!path) return send_text(static_cast<bhttp::status>(path.error().status), path.error().message + "\n", keep_alive_);
+    if (!path) return refuse(path.error());
     send_file(*path, r.kind == Artefact::model ? content_type(path->filename().string()) : content_type(artefact_file_name(r)));
+  }
+
+  // --- POST: the login and the logout (their bodies and answers are JSON) ---
+  void on_post() {
+    const auto& req = parser_->get();
+    auto route = route_post(std::string_view(req.target().data(), req.target().size()));
+    if (!route) return send_json(static_cast<bhttp::status>(route.error().status), {{"error", route.error().message}});
+    // A form another site's page posts (CSRF): the browser says whose page it is.
+    if (auto origin = server_->access.check_origin(field(bhttp::field::origin), field(bhttp::field::host)); !origin)
+      return send_json(bhttp::status::forbidden, {{"error", origin.error().message}});
+    if (*route == PostRoute::logout) {
+      server_->access.sessions().close(cookie_value(field(bhttp::field::cookie), kSessionCookie));
+      return send_json(bhttp::status::ok, {{"logged_out", true}}, server_->access.cleared_cookie());
+    }
+    login(req.body());
+  }
+
+  void login(const std::string& body) {
+    if (!server_->access.users_configured())
+      return send_json(bhttp::status::not_found, {{"error", "no users are configured ([[http.users]] in lamina.toml)"}});
+    const auto json = nlohmann::json::parse(body, nullptr, false);
+    if (json.is_discarded() || !json.is_object() || !json.contains("user") || !json["user"].is_string() ||
+        !json.contains("password") || !json["password"].is_string())
+      return send_json(bhttp::status::bad_request, {{"error", "expected {\"user\": \"…\", \"password\": \"…\"}"}});
+    const std::string name = json["user"];
+    if (auto wait = server_->access.limiter().refused_for(address_, name, now_s())) {
+      auto res = json_response(bhttp::status::too_many_requests,
+                               {{"error", fmt::format("too many failed logins; try again in {:.0f} s", std::ceil(*wait))}});
+      res->set(bhttp::field::retry_after, std::to_string(static_cast<long>(std::ceil(*wait))));
+      return write(res);
+    }
+    const WebUser* user = server_->access.user(name);
+    const std::string hash = user ? user->password_hash : server_->dummy_hash;
+    const bool queued = server_->passwords.check(
+        hash, json["password"], stream_.get_executor(), [self = shared_from_this(), name, known = user != nullptr](bool ok) {
+          self->on_password_checked(name, known && ok);
+        });
+    if (!queued) send_json(bhttp::status::service_unavailable, {{"error", "too many logins at once; try again"}});
+  }
+
+  void on_password_checked(const std::string& name, bool ok) {
+    auto& access = server_->access;
+    const WebUser* user = access.user(name);
+    if (!ok || !user) {
+      access.limiter().failed(address_, name, now_s());
+      spdlog::warn("http: failed login as '{}' from {}", name, address_);
+      return send_json(bhttp::status::unauthorized, {{"error", "wrong user name or password"}});
+    }
+    access.limiter().succeeded(address_);
+    const std::string token = access.sessions().open(user->name, user->role, now_s());
+    spdlog::info("http: {} logged in as {} from {}", user->name, role_name(user->role), address_);
+    send_json(bhttp::status::ok,
+              {{"user", user->name}, {"role", role_name(user->role)}, {"expires_in_s", access.sessions().lifetime_s()}},
+              access.session_cookie(token));
+  }
+
+  std::shared_ptr<bhttp::response<bhttp::string_body>> json_response(bhttp::status status, const nlohmann::json& body) {
+    auto res = std::make_shared<bhttp::response<bhttp::string_body>>(status, 11);
+    common_headers(*res);
+    res->set(bhttp::field::content_type, "application/json");
+    res->keep_alive(keep_alive_);
+    if (!head_only_) res->body() = body.dump() + "\n";
+    res->prepare_payload();
+    return res;
+  }
+
+  void send_json(bhttp::status status, const nlohmann::json& body, const std::string& set_cookie = {}) {
+    auto res = json_response(status, body);
+    if (!set_cookie.empty()) res->set(bhttp::field::set_cookie, set_cookie);
+    write(res);
   }
 
   void send_file(const std::filesystem::path& path, std::string_view type) {
@@ -160,16 +315,24 @@ class Session : public std::enable_shared_from_this<Session> {
 
   void finish() {
     close();
-    server_->sessions.erase(id_);
-    --server_->count;
+    finish_counting();
+  }
+
+  void finish_counting() {
+    if (std::exchange(counted_, false)) {
+      server_->sessions.erase(id_);
+      --server_->count;
+    }
   }
 
   beast::tcp_stream stream_;
   beast::flat_buffer buffer_;
-  std::optional<bhttp::request_parser<bhttp::empty_body>> parser_;
+  std::optional<bhttp::request_parser<bhttp::string_body>> parser_;
   std::shared_ptr<HttpServer::Impl> server_;
   std::uint64_t id_;
+  std::string address_, peer_;  // the client's IP (the login limiter's key), and with its port
   bool keep_alive_ = false, head_only_ = false;
+  bool counted_ = true;  // in server_->sessions and count (until closed or handed over)
 };
 
 }  // namespace
@@ -204,8 +367,9 @@ void HttpServer::Impl::close_all() {
     if (auto s = weak.lock()) s->close();
 }
 
-HttpServer::HttpServer(asio::io_context& io, HttpSettings settings, ArtefactLookup artefacts)
-    : impl_(std::make_shared<Impl>(io, std::move(settings), std::move(artefacts))) {}
+HttpServer::HttpServer(asio::io_context& io, HttpSettings settings, ArtefactLookup artefacts,
+                       WebSocketHandoff websockets)
+    : impl_(std::make_shared<Impl>(io, std::move(settings), std::move(artefacts), std::move(websockets))) {}
 
 HttpServer::~HttpServer() { stop(); }
 

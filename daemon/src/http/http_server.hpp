@@ -1,6 +1,7 @@
 #pragma once
-// laminad's web server (issue 19), on the daemon's io_context: the console's files and each
-// job's artefacts over plain HTTP GET. Routing is http_routes (sans-IO); this file moves bytes.
+// laminad's web server (issue 19), on the daemon's io_context: the console's files, each job's
+// artefacts, the login, and the WebSocket that hands a logged-in browser to the JSON-RPC server.
+// Routing is http_routes and access web_access (both sans-IO); this file moves bytes.
 // A connection gets the limits of an RPC client: a bounded request head, an idle timeout, a
 // bounded number of connections; a file is read in chunks as the client takes it.
 #include <cstddef>
@@ -13,6 +14,8 @@
 #include <boost/asio/io_context.hpp>
 
 #include "http/http_routes.hpp"
+#include "http/web_access.hpp"
+#include "rpc_transport.hpp"
 
 namespace lamina::daemon::http {
 
@@ -23,14 +26,21 @@ struct HttpSettings {
   double idle_timeout_s = 30;          // a connection that sends nothing this long is closed
   std::size_t max_header_bytes = 8192;
   std::size_t max_connections = 64;    // beyond: 503 and close
+  AccessSettings access;
+  std::size_t max_request_bytes = 1 << 20;  // a WebSocket message, as [server] max_request_bytes
 };
 
 // A job's artefact as a file to send, or why not (404: no such job or no such file yet).
 using ArtefactLookup = std::function<std::expected<std::filesystem::path, RouteError>(const ArtefactRequest&)>;
 
+// A browser through the WebSocket handshake, for the JSON-RPC server (RpcServer::adopt); the
+// reason when it cannot be taken (the transport is then dropped, which closes it).
+using WebSocketHandoff =
+    std::function<std::expected<void, std::string>(std::unique_ptr<RpcTransport>, const Visitor&, std::string peer)>;
+
 class HttpServer {
  public:
-  HttpServer(boost::asio::io_context& io, HttpSettings settings, ArtefactLookup artefacts);
+  HttpServer(boost::asio::io_context& io, HttpSettings settings, ArtefactLookup artefacts, WebSocketHandoff websockets);
   ~HttpServer();
   HttpServer(const HttpServer&) = delete;
   HttpServer& operator=(const HttpServer&) = delete;

@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "lamina/daemon/roles.hpp"
+
 #include "lamina/drivers/link_factory.hpp"
 
 namespace lamina::daemon {
@@ -65,6 +67,13 @@ struct JobsConfig {
   std::size_t max_uploads = 16;            // unfinished at once
 };
 
+// [[http.users]]: who may log in to the web console.
+struct WebUser {
+  std::string name;
+  Role role = Role::viewer;
+  std::string password_hash;  // Argon2id PHC string (laminad --hash-password)
+};
+
 // [http]: the web console (issue 19).
 struct HttpConfig {
   std::optional<std::string> host = "127.0.0.1";  // [http] listen = "HOST:PORT"; "" (nullopt): no web server
@@ -72,6 +81,15 @@ struct HttpConfig {
   std::string static_dir = "/usr/share/lamina/web";  // the console's built files
   double idle_timeout_s = 30;              // a connection silent this long is closed
   std::size_t max_connections = 64;
+  // Without users the console only watches, and only from this machine (loopback); with users
+  // every request but the console's own files needs a login, and any address may be listened on.
+  std::vector<WebUser> users;
+  double session_hours = 12;               // a login lasts a shift
+  // Host names the console is reached by, besides IP addresses, localhost and this machine's
+  // name: a request naming another host is refused (DNS rebinding).
+  std::vector<std::string> server_names;
+  // Origins allowed besides the console's own (a reverse proxy's "https://cell.example").
+  std::vector<std::string> allowed_origins;
 };
 
 struct DaemonConfig {

@@ -10,10 +10,13 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <boost/asio/io_context.hpp>
 #include <nlohmann/json.hpp>
+
+#include "lamina/daemon/roles.hpp"
 
 namespace lamina::daemon {
 
@@ -25,6 +28,7 @@ inline constexpr int method_not_found = -32601;
 inline constexpr int invalid_params = -32602;
 inline constexpr int internal_error = -32603;
 inline constexpr int unauthorized = -32001;     // TCP without the right token
+inline constexpr int forbidden = -32002;        // the client's role may not call this method
 inline constexpr int job_not_found = -32010;
 inline constexpr int invalid_state = -32011;    // e.g. confirm_sheet while planning
 inline constexpr int machine_busy = -32012;
@@ -48,14 +52,19 @@ struct RpcRequest {
 };
 
 // The listener a client came through: its limits (max_clients each) and, for TCP, the token.
-enum class Via : std::uint8_t { unix_socket, tcp };
-const char* via_name(Via via);  // "Unix", "TCP" (log lines)
+// A WebSocket comes through laminad's web server, which checked its session before adopt().
+enum class Via : std::uint8_t { unix_socket, tcp, websocket };
+const char* via_name(Via via);  // "Unix", "TCP", "WebSocket" (log lines)
 
 struct ClientContext {
   std::uint64_t id = 0;
   Via via = Via::unix_socket;
   bool subscribed = false;  // set by a handler (server.subscribe): receives broadcast()s
+  std::string user;         // who acts, for the job's events: a console login, "unix uid 1000", "tcp"
+  Role role = Role::engineer;
 };
+
+class RpcTransport;  // rpc_transport.hpp (daemon/src)
 
 struct RpcServerSettings {
   std::string unix_path;                 // empty: no Unix socket (or adopted from systemd)
@@ -98,6 +107,11 @@ class RpcServer {
   // A listening Unix socket handed over by systemd (sd_listen_fds), instead of unix_path.
   std::expected<void, std::string> adopt_unix_listener(int fd);
   int tcp_port() const;  // the bound port (after listen)
+  // A client whose transport another server opened and vouched for (a WebSocket with a valid
+  // session): it gets the pipeline and limits of any client, and max_clients of its own kind.
+  // Refused (the reason returned) when stopped or full. Call on the io thread.
+  std::expected<void, std::string> adopt(std::unique_ptr<RpcTransport> transport, Via via, std::string user,
+                                         Role role, std::string peer);
 
   // Thread-safe: a notification {"jsonrpc":"2.0","method":…,"params":…} to subscribed clients.
   void broadcast(const std::string& method, const nlohmann::json& params);
