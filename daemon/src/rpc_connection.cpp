@@ -194,7 +194,8 @@ void Connection::dispatch_next() {
     read_paused_ = false;
     read_next();
   }
-  boost::asio::post(shared_->worker, [self = shared_from_this(), next = std::move(next), context = context_]() mutable {
+  boost::asio::post(shared_->worker, [self = shared_from_this(), next = std::move(next), context = context_,
+                                      was_subscribed = context_.subscribed]() mutable {
     nlohmann::json id;
     bool notification = false;
     RpcResult result = std::unexpected(RpcError{rpc_code::internal_error, "internal error", {}});
@@ -214,11 +215,14 @@ void Connection::dispatch_next() {
       result = self->invoke(*request, context);
     }
     // The handler worked on a copy of the client's context: what it changed (a subscription)
-    // is applied on the io thread, where broadcasts read it.
+    // is applied on the io thread, where broadcasts read it. Only a change: an inline
+    // server.subscribe that overtook this request must not be undone by its reply.
+    const std::optional<bool> subscribed =
+        context.subscribed != was_subscribed ? std::optional<bool>(context.subscribed) : std::nullopt;
     boost::asio::post(self->transport_->executor(), [self, id = std::move(id), notification, result = std::move(result),
-                                                     subscribed = context.subscribed] {
+                                                     subscribed] {
       std::lock_guard lock(self->shared_->mutex);
-      self->context_.subscribed = subscribed;
+      if (subscribed) self->context_.subscribed = *subscribed;
       self->on_worker_done(id, notification, result);
     });
   });

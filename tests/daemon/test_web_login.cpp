@@ -3,6 +3,7 @@
 // roles' effect on the real methods is LaminadWeb's (test_laminad_web.cpp).
 #include <gtest/gtest.h>
 
+#include <set>
 #include <thread>
 
 #include <boost/asio/executor_work_guard.hpp>
@@ -38,8 +39,10 @@ struct Console {
   explicit Console(std::size_t max_request_bytes = 1 << 20) {
     RpcServerSettings rs;
     rs.max_request_bytes = max_request_bytes;
+    rs.inline_methods = {"server.subscribe"};  // as laminad: on the io thread, ahead of the queue
     rpc = std::make_unique<RpcServer>(io, rs, [](const RpcRequest& r, ClientContext& client) -> RpcResult {
       if (r.method == "server.subscribe") client.subscribed = true;
+      if (r.method == "slow") std::this_thread::sleep_for(std::chrono::milliseconds(100));
       return nlohmann::json{{"user", client.user}, {"role", role_name(client.role)}, {"via", via_name(client.via)}};
     });
     HttpSettings s;
@@ -186,6 +189,29 @@ TEST(WebSocketRpc, ABrowserGetsTheNotificationsItSubscribedTo) {
   const auto note = nlohmann::json::parse(*text);
   EXPECT_EQ(note["method"], "notify_machine_status");
   EXPECT_EQ(note["params"]["state"], "Run");
+}
+
+// The console's first two calls: one for the worker, one inline that overtakes it. Neither reply
+// may be lost, and the worker's reply must not undo the subscription (it did: the console then
+// never heard of its job again).
+TEST(WebSocketRpc, AnInlineSubscribeThatOvertakesAWorkersRequestStays) {
+  Console console;
+  const std::string cookie = session_cookie(console.login("vic", "vic's password"));
+  WsClient ws(console.port(), cookie, console.origin());
+  ASSERT_TRUE(ws.open());
+  ws.send(R"({"jsonrpc":"2.0","id":1,"method":"slow"})");
+  ws.send(R"({"jsonrpc":"2.0","id":2,"method":"server.subscribe"})");
+  std::set<int> replies;
+  for (int i = 0; i < 2; ++i) {
+    const auto text = ws.receive();
+    ASSERT_TRUE(text) << "reply " << i + 1 << " of 2 never came; got " << replies.size();
+    replies.insert(nlohmann::json::parse(*text)["id"].get<int>());
+  }
+  EXPECT_EQ(replies, (std::set<int>{1, 2}));
+  console.rpc->broadcast("notify_machine_status", {{"state", "Idle"}});
+  const auto note = ws.receive();
+  ASSERT_TRUE(note) << "subscribed, but no notification came";
+  EXPECT_EQ(nlohmann::json::parse(*note)["method"], "notify_machine_status");
 }
 
 TEST(WebSocketRpc, AMessageOverTheRequestLimitIsRefusedAsOnEveryTransport) {

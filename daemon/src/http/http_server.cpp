@@ -43,7 +43,9 @@ void common_headers(Response& res) {
   res.set(bhttp::field::server, "laminad");
   res.set(bhttp::field::cache_control, "no-cache");
   res.set("X-Content-Type-Options", "nosniff");
-  res.set("Content-Security-Policy", "default-src 'self'; connect-src 'self'; img-src 'self' data: blob:");
+  // Inline styles only (the planner's SVG drawings carry a <style>); scripts from our files only.
+  res.set("Content-Security-Policy",
+          "default-src 'self'; connect-src 'self'; img-src 'self' data: blob:; style-src 'self' 'unsafe-inline'");
   res.set("X-Frame-Options", "DENY");
 }
 
