@@ -1,6 +1,7 @@
 # Sourced by the daemon benchmarks: lamina-sim (real time, 115200 baud) and laminad on $work,
 # the example knob submitted, planned and its first sheet confirmed. Needs $root, $build, $work;
-# $rig_tcp ("HOST:PORT", optional) also opens laminad's TCP listener with the token "bench".
+# $rig_tcp ("HOST:PORT", optional) also opens laminad's TCP listener with the token "bench";
+# $rig_http ("HOST:PORT", optional) the web console, with the operator "bench" (password "bench").
 # Leaves $lamina, $id, $control (the simulator's control port) and LAMINA_SOCKET set.
 json() { python3 -c "import json,sys; d=json.load(sys.stdin); print(eval(sys.argv[1]))" "$1"; }
 
@@ -11,6 +12,8 @@ modbus=$(head -1 "$work/ready" | json 'd["modbus_port"]')
 control=$(head -1 "$work/ready" | json 'd["control_port"]')
 tcp_lines=""
 [[ -n "${rig_tcp:-}" ]] && tcp_lines=$'tcp = "'"$rig_tcp"$'"\ntoken = "bench"'
+http_lines='listen = ""'
+[[ -n "${rig_http:-}" ]] && http_lines=$'listen = "'"$rig_http"$'"\n[[http.users]]\nname = "bench"\nrole = "operator"\npassword_hash = "'"$(echo bench | "$build/daemon/laminad" --hash-password)"'"'
 cat > "$work/lamina.toml" <<TOML
 state_dir = "$work/state"
 [server]
@@ -18,7 +21,7 @@ socket = "$work/lamina.sock"
 socket_group = ""
 $tcp_lines
 [http]
-listen = ""
+$http_lines
 [link]
 protocol = "grbl"
 port = "$work/cnc"

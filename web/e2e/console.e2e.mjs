@@ -9,7 +9,7 @@
 // the first failed check, naming it.
 import { chromium } from "playwright-core";
 import http from "node:http";
-import { mkdirSync } from "node:fs";
+import { mkdirSync, rmSync } from "node:fs";
 import { join } from "node:path";
 
 const url = process.env.LAMINA_URL;
@@ -17,6 +17,7 @@ const model = process.env.LAMINA_MODEL;
 const shots = process.env.LAMINA_SHOTS;
 const users = JSON.parse(process.env.LAMINA_USERS ?? "{}");
 const limit = (s) => s * 1000;
+rmSync(shots, { recursive: true, force: true });  // this run's screenshots only
 mkdirSync(shots, { recursive: true });
 
 const say = (step, extra = {}) => console.log(JSON.stringify({ step, ...extra }));
