@@ -25,6 +25,12 @@ for f in ./usr/sbin/laminad ./usr/bin/lamina ./usr/bin/lamina-sim ./usr/lib/syst
          ./etc/lamina/lamina.toml; do
   grep -qx "$f" "$work/files" || fail "$f is not in the package"
 done
+# The web console, when this build made it (-DLAMINA_BUILD_WEB, on by default).
+if [[ -f "$build/web/index.html" ]]; then
+  for f in ./usr/share/lamina/web/index.html ./usr/share/lamina/web/app.js ./usr/share/lamina/web/style.css; do
+    grep -qx "$f" "$work/files" || fail "$f is not in the package"
+  done
+fi
 dpkg-deb -e "$deb" "$work/control"
 grep -qx /etc/lamina/lamina.toml "$work/control/conffiles" || fail "/etc/lamina/lamina.toml is not a conffile"
 for s in postinst prerm postrm; do [[ -x "$work/control/$s" ]] || fail "$s is missing or not executable"; done
