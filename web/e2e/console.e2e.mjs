@@ -157,6 +157,8 @@ async function engineerSubmits(browser, metrics) {
   await page.waitForSelector("#layers tr:nth-child(2)", { timeout: limit(20) });
   const layers = await page.$$eval("#layers tr", (rows) => rows.length - 1);
   check(layers > 0, `the layer table lists ${layers} layers`);
+  const warnings = await page.$$eval("#plan-warnings li", (items) => items.length);
+  check(warnings > 0, `the plan's ${warnings} warnings are listed`);
   await page.waitForFunction(() => !!document.querySelector(".stack3d canvas"), null, { timeout: limit(20) });
   let colours = 0;
   for (let i = 0; i < 100 && colours < 10; ++i) {

@@ -10,6 +10,7 @@ import { progressOf } from "./queue_view";
 interface Report {
   layers: { index: number; z_bottom_mm: number; thickness_mm: number; passes: number; max_deviation_mm: number; within_tolerance: boolean }[];
   shortfalls: { z_from_mm: number; z_to_mm: number; deviation_mm: number }[];
+  warnings: string[];
   deviation: Record<string, { volume_pct: number; max_mm: number }>;
   settings: { strategy: string; tolerance_mm: number };
   sheets: { index: number; thickness_mm: number; width_mm: number; length_mm: number; material: string; estimated_time_s: number; parts: { layer: number }[] }[];
@@ -105,6 +106,7 @@ export class JobView {
       h("h2", {}, "Layers"),
       layerTable(report),
       report.shortfalls.length ? h("p", { class: "warn-text" }, `Beyond tolerance: ${report.shortfalls.map((s) => `z ${fmt(s.z_from_mm)}–${fmt(s.z_to_mm)} mm (${fmt(s.deviation_mm, 2)} mm)`).join(", ")}`) : null,
+      report.warnings.length ? h("ul", { class: "warnings", id: "plan-warnings" }, ...report.warnings.map((w) => h("li", { class: "warn-text" }, w))) : null,
       h("h2", {}, "Deviation from the model"),
       deviationChart(report),
       h("h2", {}, "Stack"),
