@@ -166,7 +166,7 @@ async function engineerSubmits(browser, metrics) {
     colours = await canvasColours(page);
   }
   check(colours >= 10, `the 3D view drew the stack (${colours} colours sampled)`);
-  await page.waitForFunction(() => [...document.querySelectorAll(".sheet-drawing")].some((i) => i.complete && i.naturalWidth > 0), null, { timeout: limit(20) });
+  await page.waitForFunction(() => [...document.querySelectorAll("svg.sheet-drawing")].some((s) => s.getBoundingClientRect().width > 100 && s.querySelector("#sheet")), null, { timeout: limit(20) });
   check(true, "a sheet drawing is shown");
   await page.locator(".stack3d").screenshot({ path: join(shots, "stack-3d.png") });
   await page.screenshot({ path: join(shots, "job.png"), fullPage: true });

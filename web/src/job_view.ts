@@ -74,7 +74,7 @@ export class JobView {
         this.prompt,
         h("h2", {}, `Load sheet ${sheet.index} of ${job.sheets.length}`),
         h("p", { class: "large" }, `${fmt(sheet.thickness_mm, 1)} mm ${sheet.material} ${size}`),
-        h("img", { src: this.artefact(`sheet-${sheet.index}.svg`), class: "prompt-drawing", alt: `sheet ${sheet.index}` }),
+        h("div", { class: "prompt-drawing" }, new SheetView(this.artefact(`sheet-${sheet.index}.svg`), `sheet ${sheet.index}`).element),
         act("job.confirm_sheet", { job: job.id, sheet: sheet.index }, `Sheet ${sheet.index} is loaded: cut it`),
       );
     } else if (job.state === "paused") {
