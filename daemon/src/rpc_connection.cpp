@@ -196,6 +196,15 @@ void Connection::dispatch_next() {
   }
   boost::asio::post(shared_->worker, [self = shared_from_this(), next = std::move(next), context = context_,
                                       was_subscribed = context_.subscribed]() mutable {
+    {
+      // Closed while it waited (the client left, the server stopped): not run. Released under
+      // the lock, as the io thread's handlers do, in case this was the last reference.
+      std::lock_guard lock(self->shared_->mutex);
+      if (self->closed_) {
+        self.reset();
+        return;
+      }
+    }
     nlohmann::json id;
     bool notification = false;
     RpcResult result = std::unexpected(RpcError{rpc_code::internal_error, "internal error", {}});

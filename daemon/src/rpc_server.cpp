@@ -373,10 +373,12 @@ RpcServer::~RpcServer() {
     std::lock_guard lock(impl_->shared->mutex);
     impl_->stop("server destroyed");
   }
-  // A handler still running on the worker finishes (its reply finds the connection closed);
-  // none starts after this. Not under the lock: the handler's reply takes it.
+  // A handler still running on the worker finishes (its reply finds the connection closed).
+  // The requests queued behind it are drained, not dropped: each finds its connection closed
+  // and releases it. A stopped io_context would keep them, and with them their connections,
+  // which keep the shared state that owns the queue (a cycle). Not under the lock: the
+  // handler's reply takes it.
   impl_->worker_guard.reset();
-  impl_->shared->worker.stop();
   if (impl_->worker_thread.joinable()) impl_->worker_thread.join();
   std::lock_guard lock(impl_->shared->mutex);
   // Completion handlers still queued keep the shared state alive; they find every connection

@@ -5,8 +5,12 @@
 #include <sys/stat.h>
 
 #include <fstream>
+#include <future>
+
+#include <boost/asio/post.hpp>
 
 #include "rpc_test_support.hpp"
+#include "rpc_transport.hpp"
 
 namespace lamina::daemon::test {
 namespace {
@@ -187,6 +191,89 @@ TEST_F(RpcLifecycle, TheDestructorWorksWhenTheIoContextNeverRanOrHasStopped) {
   server_.reset();  // io_context stopped with the connection's read still pending
   EXPECT_FALSE(std::filesystem::exists(socket_path()));
   EXPECT_FALSE(client.call("echo", json::object(), 3).has_value());
+}
+
+// A client that sends one line, then waits; it tells when it is destroyed and when it is closed.
+class OneLineTransport final : public RpcTransport {
+ public:
+  OneLineTransport(boost::asio::io_context& io, std::string line, std::atomic<bool>& destroyed,
+                   std::function<void()> on_close = {})
+      : io_(io), line_(std::move(line)), destroyed_(destroyed), on_close_(std::move(on_close)) {}
+  ~OneLineTransport() override { destroyed_ = true; }
+  boost::asio::any_io_executor executor() override { return io_.get_executor(); }
+  void async_read(ReadHandler handler) override {
+    ++reads;
+    if (line_.empty()) {
+      waiting_ = std::move(handler);
+      return;
+    }
+    boost::asio::post(io_, [handler = std::move(handler), line = std::exchange(line_, {})] { handler({}, line); });
+  }
+  void async_write(std::span<const Line>, WriteHandler handler) override {
+    boost::asio::post(io_, [handler = std::move(handler)] { handler({}); });
+  }
+  void shutdown_send() override {}
+  void close() override {
+    if (waiting_)
+      boost::asio::post(io_, [handler = std::exchange(waiting_, {})] { handler(boost::asio::error::operation_aborted, {}); });
+    if (auto callback = std::exchange(on_close_, {})) callback();
+  }
+  std::atomic<int> reads{0};
+
+ private:
+  boost::asio::io_context& io_;
+  std::string line_;
+  std::atomic<bool>& destroyed_;
+  std::function<void()> on_close_;
+  ReadHandler waiting_;
+};
+
+// One client's request runs on the worker while another's waits behind it when the server goes.
+// The waiting one must never run (its client is gone, the server stopped) and its client must be
+// released: a request left in the worker's queue held its connection, which held the queue.
+TEST_F(RpcLifecycle, ARequestStillWaitingWhenTheServerGoesNeverRunsAndItsClientIsReleased) {
+  std::atomic<bool> slow_gone{false};
+  std::atomic<bool> waiting_gone{false};
+  std::atomic<bool> slow_started{false};
+  std::atomic<int> late_calls{0};
+  std::promise<void> release;
+  std::shared_future<void> released = release.get_future().share();
+  {
+    boost::asio::io_context io;
+    auto guard = boost::asio::make_work_guard(io);
+    std::thread io_thread([&io] { io.run(); });
+    auto server = std::make_unique<RpcServer>(io, RpcServerSettings{}, [&](const RpcRequest& request, ClientContext&) -> RpcResult {
+      if (request.method == "slow") {
+        slow_started = true;
+        released.wait();
+      } else {
+        ++late_calls;
+      }
+      return nullptr;
+    });
+    auto slow = std::make_unique<OneLineTransport>(io, R"({"jsonrpc":"2.0","id":1,"method":"slow"})" "\n", slow_gone,
+                                                   [&release] { release.set_value(); });
+    auto waiting = std::make_unique<OneLineTransport>(io, R"({"jsonrpc":"2.0","id":2,"method":"quick"})" "\n", waiting_gone);
+    OneLineTransport& waiting_view = *waiting;
+    std::promise<void> adopted;
+    boost::asio::post(io, [&] {
+      EXPECT_TRUE(server->adopt(std::move(slow), Via::websocket, "a", Role::engineer, "a").has_value());
+      adopted.set_value();
+    });
+    adopted.get_future().wait();
+    EXPECT_TRUE(eventually([&] { return slow_started.load(); }));
+    boost::asio::post(io, [&] {
+      (void)server->adopt(std::move(waiting), Via::websocket, "b", Role::engineer, "b");
+    });
+    // Its first line taken, the waiting client reads again: its request is in the worker's queue.
+    EXPECT_TRUE(eventually([&] { return waiting_view.reads.load() >= 2; }));
+    server.reset();  // closing the slow client lets its request finish
+    guard.reset();
+    io_thread.join();
+  }
+  EXPECT_EQ(late_calls.load(), 0) << "a closed client's request ran after the server stopped";
+  EXPECT_TRUE(slow_gone.load());
+  EXPECT_TRUE(waiting_gone.load()) << "the client whose request waited for the worker was never released";
 }
 
 }  // namespace

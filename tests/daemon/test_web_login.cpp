@@ -3,11 +3,14 @@
 // roles' effect on the real methods is LaminadWeb's (test_laminad_web.cpp).
 #include <gtest/gtest.h>
 
+#include <future>
+#include <optional>
 #include <set>
 #include <thread>
 
 #include <boost/asio/executor_work_guard.hpp>
 #include <boost/asio/io_context.hpp>
+#include <boost/asio/post.hpp>
 
 #include "http/http_server.hpp"
 #include "http/passwords.hpp"
@@ -189,6 +192,26 @@ TEST(WebSocketRpc, ABrowserGetsTheNotificationsItSubscribedTo) {
   const auto note = nlohmann::json::parse(*text);
   EXPECT_EQ(note["method"], "notify_machine_status");
   EXPECT_EQ(note["params"]["state"], "Run");
+}
+
+// A console that stops reading while the daemon stops: its write is still pending when the
+// io_context goes. The connection and its WebSocket must be freed with it (the pending write's
+// handler was kept in the transport, which the connection owns: the sanitizer pass found the
+// cycle as a leak).
+TEST(WebSocketRpc, AConsoleThatStopsReadingIsFreedWhenTheDaemonStops) {
+  std::optional<Console> console(std::in_place);
+  const std::string cookie = session_cookie(console->login("vic", "vic's password"));
+  WsClient ws(console->port(), cookie, console->origin());
+  ASSERT_TRUE(ws.open());
+  ASSERT_TRUE(ws.call("server.subscribe").contains("result"));
+  // 4 MiB the client never reads: far past what the sockets buffer, short of the 8 MiB limit.
+  const std::string chunk(128 * 1024, 'x');
+  for (int i = 0; i < 32; ++i) console->rpc->broadcast("notify_log", {{"text", chunk}});
+  std::promise<void> queued;  // the broadcasts were posted before this, on the one io thread
+  boost::asio::post(console->io, [&queued] { queued.set_value(); });
+  ASSERT_EQ(queued.get_future().wait_for(std::chrono::seconds(30)), std::future_status::ready);
+  EXPECT_EQ(console->rpc->client_count(), 1U) << "dropped instead of left writing";
+  console.reset();  // LeakSanitizer (the sanitizer pass) reports what this leaves behind
 }
 
 // The console's first two calls: one for the worker, one inline that overtakes it. Neither reply

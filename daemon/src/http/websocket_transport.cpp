@@ -38,8 +38,7 @@ class WebSocketTransport final : public RpcTransport {
   void async_write(std::span<const Line> lines, WriteHandler handler) override {
     pending_.assign(lines.begin(), lines.end());
     next_ = 0;
-    write_handler_ = std::move(handler);
-    write_next();
+    write_next(std::move(handler));
   }
 
   void shutdown_send() override {
@@ -56,20 +55,23 @@ class WebSocketTransport final : public RpcTransport {
 
  private:
   // A message per line, one after the other (a WebSocket has one write in flight at a time).
-  void write_next() {
+  // The handler travels in the operation, never in a member: it holds the connection, which
+  // owns this transport, and an io_context destroyed with the write pending must free it.
+  void write_next(WriteHandler handler) {
     if (next_ == pending_.size()) {
       pending_.clear();
-      return std::exchange(write_handler_, nullptr)(boost::system::error_code{});
+      return handler(boost::system::error_code{});
     }
     const std::string& line = *pending_[next_++];
     const std::size_t size = !line.empty() && line.back() == '\n' ? line.size() - 1 : line.size();
-    ws_.async_write(boost::asio::buffer(line.data(), size), [this](const boost::system::error_code& error, std::size_t) {
-      if (error) {
-        pending_.clear();
-        return std::exchange(write_handler_, nullptr)(error);
-      }
-      write_next();
-    });
+    ws_.async_write(boost::asio::buffer(line.data(), size),
+                    [this, handler = std::move(handler)](const boost::system::error_code& error, std::size_t) mutable {
+                      if (error) {
+                        pending_.clear();
+                        return handler(error);
+                      }
+                      write_next(std::move(handler));
+                    });
   }
 
   // The connection owns the transport and its handlers hold the connection, so `this` outlives
@@ -79,7 +81,6 @@ class WebSocketTransport final : public RpcTransport {
   std::string line_;
   std::vector<Line> pending_;
   std::size_t next_ = 0;
-  WriteHandler write_handler_;
   bool closing_ = false;
 };
 
