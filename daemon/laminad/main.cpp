@@ -162,7 +162,10 @@ std::unique_ptr<http::HttpServer> start_web(boost::asio::io_context& io, const D
   s.idle_timeout_s = c.idle_timeout_s;
   s.max_connections = c.max_connections;
   s.max_request_bytes = config.server.max_request_bytes;
-  s.access = http::AccessSettings{c.users, c.session_hours * 3600, c.server_names, c.allowed_origins, machine_name()};
+  s.tls_cert = c.tls_cert;
+  s.tls_key = c.tls_key;
+  s.access = http::AccessSettings{c.users,           c.session_hours * 3600, c.server_names,
+                                  c.allowed_origins, machine_name(),         !c.tls_cert.empty()};
   auto handoff = [&rpc](std::unique_ptr<RpcTransport> transport, const http::Visitor& who, std::string peer) {
     return rpc.adopt(std::move(transport), Via::websocket, who.user, who.role, std::move(peer));
   };
@@ -171,8 +174,11 @@ std::unique_ptr<http::HttpServer> start_web(boost::asio::io_context& io, const D
     spdlog::error("{}", r.error());
     return nullptr;
   }
-  spdlog::info("web console: http://{}:{}/ (files from {}; {})", s.host, web->port(), s.static_dir.string(),
-               c.users.empty() ? "no users: viewing only" : fmt::format("{} users", c.users.size()));
+  spdlog::info("web console: {}://{}:{}/ (files from {}; {})", web->tls() ? "https" : "http", s.host, web->port(),
+               s.static_dir.string(), c.users.empty() ? "no users: viewing only" : fmt::format("{} users", c.users.size()));
+  if (!web->tls() && !c.users.empty() && *c.host != "127.0.0.1" && *c.host != "::1" && *c.host != "localhost")
+    spdlog::warn("web console: passwords and session cookies cross the network in clear text; set [http] tls_cert "
+                 "and tls_key, or serve it through a TLS proxy (docs/web.md)");
   return web;
 }
 

@@ -178,8 +178,9 @@ constexpr std::array kServerKeys{"socket"sv,        "socket_mode"sv,       "sock
                                  "tcp"sv,           "token"sv,             "token_file"sv,
                                  "max_request_bytes"sv, "max_clients"sv,   "idle_timeout_s"sv,
                                  "pre_auth_timeout_s"sv};
-constexpr std::array kHttpKeys{"listen"sv,         "static_dir"sv,   "idle_timeout_s"sv, "max_connections"sv,
-                               "users"sv,          "session_hours"sv, "server_names"sv,  "allowed_origins"sv};
+constexpr std::array kHttpKeys{"listen"sv,        "static_dir"sv,      "idle_timeout_s"sv, "max_connections"sv,
+                               "users"sv,         "session_hours"sv,   "server_names"sv,   "allowed_origins"sv,
+                               "tls_cert"sv,      "tls_key"sv};
 constexpr std::array kWebUserKeys{"name"sv, "role"sv, "password_hash"sv};
 constexpr std::array kLinkKeys{"protocol"sv, "port"sv, "tcp"sv, "baud"sv, "rx_buffer"sv, "status_hz"sv, "stall_margin_s"sv};
 constexpr std::array kCellKeys{"enabled"sv, "modbus"sv, "modbus_unit"sv, "modbus_timeout_s"sv,
@@ -313,6 +314,10 @@ void read_http(Reader& r, Section s, HttpConfig& c) {
   s.number("session_hours", c.session_hours, {0.01, 24 * 31});
   read_strings(s, "server_names", c.server_names);
   read_strings(s, "allowed_origins", c.allowed_origins);
+  s.path("tls_cert", c.tls_cert);
+  s.path("tls_key", c.tls_key);
+  if (c.tls_cert.empty() != c.tls_key.empty())
+    s.fail(c.tls_cert.empty() ? "tls_key" : "tls_cert", "tls_cert and tls_key go together (the certificate and its key)");
 }
 
 void read_link(Section s, MachineLinkConfig& c) {

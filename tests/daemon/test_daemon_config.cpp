@@ -123,7 +123,8 @@ TEST(DaemonConfig, TheDefaultsFileShowsEveryKey) {
                           "abrasive_g_per_min", "hold_limit_s", "jet_restart_s", "lamina", "workers", "machine",
                           "materials", "timeout_s", "memory_limit_mb", "cpu_limit_s", "nice", "roots",
                           "max_model_bytes", "max_stock_file_bytes", "upload_idle_s", "max_uploads", "listen",
-                          "static_dir", "max_connections", "session_hours", "server_names", "allowed_origins"})
+                          "static_dir", "max_connections", "session_hours", "server_names", "allowed_origins",
+                          "tls_cert", "tls_key"})
     EXPECT_NE(text.find(std::string("\n") + key + " = "), std::string::npos) << key;
 }
 
@@ -202,6 +203,19 @@ TEST(DaemonConfig, WebUsersLetTheConsoleListenOnAnyAddress) {
   EXPECT_EQ(c->http.users[0].password_hash, kHash);
   EXPECT_EQ(c->http.session_hours, 8);
   EXPECT_EQ(c->http.server_names, std::vector<std::string>{"cell-7"});
+}
+
+TEST(DaemonConfig, HttpsTakesACertificateAndItsKeyTogether) {
+  auto c = parse_daemon_config("[http]\ntls_cert = \"tls/cell.crt\"\ntls_key = \"/etc/ssl/private/cell.key\"\n",
+                               "/etc/lamina/lamina.toml");
+  ASSERT_TRUE(c.has_value()) << c.error().message;
+  EXPECT_EQ(c->http.tls_cert, "/etc/lamina/tls/cell.crt");  // from the file's folder, as every path
+  EXPECT_EQ(c->http.tls_key, "/etc/ssl/private/cell.key");
+  const std::string alone = error_of("[http]\ntls_cert = \"cell.crt\"\n");
+  EXPECT_NE(alone.find("test.toml:2: [http] tls_cert: tls_cert and tls_key go together"), std::string::npos) << alone;
+  const std::string key_only = error_of("[http]\nlisten = \"127.0.0.1:8443\"\ntls_key = \"cell.key\"\n");
+  EXPECT_NE(key_only.find("test.toml:3: [http] tls_key: tls_cert and tls_key go together"), std::string::npos)
+      << key_only;
 }
 
 TEST(DaemonConfig, AWebUserWithAWrongRoleHashOrNameIsAnErrorAtItsLine) {

@@ -1,7 +1,8 @@
 #pragma once
 // A WebSocket client for the web console's tests (Boost.Beast, as a browser would speak it):
 // the handshake with the headers a test chooses (Cookie, Origin), JSON-RPC calls as text
-// messages. Every wait is bounded (10 s) so a hung server fails a test instead of hanging it.
+// messages; over TCP (ws://) or TLS (wss://, the server's certificate verified for localhost).
+// Every wait is bounded (10 s) so a hung server fails a test instead of hanging it.
 #include <chrono>
 #include <optional>
 #include <stdexcept>
@@ -10,27 +11,46 @@
 #include <boost/asio/connect.hpp>
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/ip/tcp.hpp>
+#include <boost/asio/ssl.hpp>
 #include <boost/beast/core.hpp>
 #include <boost/beast/http.hpp>
+#include <boost/beast/ssl.hpp>
 #include <boost/beast/websocket.hpp>
+#include <boost/beast/websocket/ssl.hpp>
 #include <nlohmann/json.hpp>
 
 namespace lamina::daemon::testing {
 
-class WsClient {
+using TlsTcpStream = boost::beast::ssl_stream<boost::beast::tcp_stream>;
+
+// NextLayer: boost::beast::tcp_stream, or TlsTcpStream (give the constructor a client context).
+template <class NextLayer>
+class BasicWsClient {
  public:
   // Connects and shakes hands; `refusal` gets the server's HTTP answer when it does not upgrade.
-  WsClient(int port, const std::string& cookie, const std::string& origin) : ws_(io_) {
+  template <class... TlsContext>
+  BasicWsClient(int port, const std::string& cookie, const std::string& origin, TlsContext&... tls)
+      : ws_(io_, tls...) {
     namespace bhttp = boost::beast::http;
     boost::asio::ip::tcp::endpoint at(boost::asio::ip::make_address("127.0.0.1"), static_cast<unsigned short>(port));
     boost::beast::get_lowest_layer(ws_).expires_after(std::chrono::seconds(10));
     boost::beast::get_lowest_layer(ws_).connect(at);
+    boost::system::error_code ec;
+    if constexpr (sizeof...(TlsContext) > 0) {
+      auto& tls_stream = ws_.next_layer();
+      SSL_set_tlsext_host_name(tls_stream.native_handle(), "localhost");
+      tls_stream.set_verify_callback(boost::asio::ssl::host_name_verification("localhost"));
+      tls_stream.handshake(boost::asio::ssl::stream_base::client, ec);
+      if (ec) {
+        refusal_ = "TLS: " + ec.message();
+        return;
+      }
+    }
     ws_.set_option(boost::beast::websocket::stream_base::decorator([&](boost::beast::websocket::request_type& req) {
       if (!cookie.empty()) req.set(bhttp::field::cookie, cookie);
       if (!origin.empty()) req.set(bhttp::field::origin, origin);
     }));
     boost::beast::websocket::response_type res;
-    boost::system::error_code ec;
     ws_.handshake(res, "localhost:" + std::to_string(port), "/ws", ec);
     if (ec) {
       status_ = res.result_int();
@@ -85,10 +105,13 @@ class WsClient {
 
  private:
   boost::asio::io_context io_;
-  boost::beast::websocket::stream<boost::beast::tcp_stream> ws_;
+  boost::beast::websocket::stream<NextLayer> ws_;
   unsigned status_ = 0;
   std::string refusal_;
   int next_id_ = 0;
 };
+
+using WsClient = BasicWsClient<boost::beast::tcp_stream>;
+using WssClient = BasicWsClient<TlsTcpStream>;
 
 }  // namespace lamina::daemon::testing

@@ -28,6 +28,9 @@ struct HttpSettings {
   std::size_t max_connections = 64;    // beyond: 503 and close
   AccessSettings access;
   std::size_t max_request_bytes = 1 << 20;  // a WebSocket message, as [server] max_request_bytes
+  // Both set: HTTPS and wss:// only (PEM files: the certificate chain, then its private key).
+  // access.tls must then be true too (Secure cookies, https:// origins).
+  std::filesystem::path tls_cert, tls_key;
 };
 
 // A job's artefact as a file to send, or why not (404: no such job or no such file yet).
@@ -45,9 +48,11 @@ class HttpServer {
   HttpServer(const HttpServer&) = delete;
   HttpServer& operator=(const HttpServer&) = delete;
 
-  // Binds and listens; the error names the address.
+  // Loads the TLS certificate and key when set, binds and listens; the error names the file or
+  // the address.
   std::expected<void, std::string> listen();
   int port() const;
+  bool tls() const;  // after listen()
   // Stop accepting; close every connection. Thread-safe.
   void stop();
   std::size_t connection_count() const;

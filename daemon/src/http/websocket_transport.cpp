@@ -8,15 +8,18 @@
 #include <boost/beast/core/buffers_to_string.hpp>
 #include <boost/beast/core/flat_buffer.hpp>
 #include <boost/beast/websocket.hpp>
+#include <boost/beast/websocket/ssl.hpp>
 
 namespace lamina::daemon::http {
 namespace {
 
 namespace websocket = boost::beast::websocket;
 
+// Over plain TCP or over TLS: the same messages, the stream underneath differs.
+template <class Stream>
 class WebSocketTransport final : public RpcTransport {
  public:
-  WebSocketTransport(WebSocket ws, std::size_t max_request_bytes) : ws_(std::move(ws)) {
+  WebSocketTransport(Stream ws, std::size_t max_request_bytes) : ws_(std::move(ws)) {
     ws_.read_message_max(max_request_bytes + 1);
     ws_.text(true);
   }
@@ -76,7 +79,7 @@ class WebSocketTransport final : public RpcTransport {
 
   // The connection owns the transport and its handlers hold the connection, so `this` outlives
   // every operation.
-  WebSocket ws_;
+  Stream ws_;
   boost::beast::flat_buffer in_;
   std::string line_;
   std::vector<Line> pending_;
@@ -87,10 +90,16 @@ class WebSocketTransport final : public RpcTransport {
 }  // namespace
 
 std::unique_ptr<RpcTransport> make_websocket_transport(WebSocket ws, std::size_t max_request_bytes) {
-  return std::make_unique<WebSocketTransport>(std::move(ws), max_request_bytes);
+  return std::make_unique<WebSocketTransport<WebSocket>>(std::move(ws), max_request_bytes);
 }
 
-void set_websocket_timeouts(WebSocket& ws, double idle_timeout_s) {
+std::unique_ptr<RpcTransport> make_websocket_transport(TlsWebSocket ws, std::size_t max_request_bytes) {
+  return std::make_unique<WebSocketTransport<TlsWebSocket>>(std::move(ws), max_request_bytes);
+}
+
+namespace {
+template <class Stream>
+void set_timeouts(Stream& ws, double idle_timeout_s) {
   websocket::stream_base::timeout t{};
   t.handshake_timeout = std::chrono::seconds(10);
   t.idle_timeout = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
@@ -98,5 +107,9 @@ void set_websocket_timeouts(WebSocket& ws, double idle_timeout_s) {
   t.keep_alive_pings = true;  // a ping at half the idle time; no answer by the end: closed
   ws.set_option(t);
 }
+}  // namespace
+
+void set_websocket_timeouts(WebSocket& ws, double idle_timeout_s) { set_timeouts(ws, idle_timeout_s); }
+void set_websocket_timeouts(TlsWebSocket& ws, double idle_timeout_s) { set_timeouts(ws, idle_timeout_s); }
 
 }  // namespace lamina::daemon::http

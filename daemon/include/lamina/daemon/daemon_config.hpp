@@ -90,6 +90,9 @@ struct HttpConfig {
   std::vector<std::string> server_names;
   // Origins allowed besides the console's own (a reverse proxy's "https://cell.example").
   std::vector<std::string> allowed_origins;
+  // HTTPS: a PEM certificate (chain) and its private key, both or neither. Relative paths are
+  // from the configuration file's folder.
+  std::string tls_cert, tls_key;
 };
 
 struct DaemonConfig {
