@@ -25,6 +25,7 @@
 #include "http/http_server.hpp"
 #include "http/passwords.hpp"
 #include "http/job_artefacts.hpp"
+#include "http/upload_sink.hpp"
 #include "job_manager.hpp"
 #include "lamina/daemon/daemon_config.hpp"
 #include "lamina/daemon/job_store.hpp"
@@ -152,7 +153,7 @@ std::string machine_name() {
 // The console's HTTP server; a browser's WebSocket becomes a client of the RPC server, with
 // the user and role of its login.
 std::unique_ptr<http::HttpServer> start_web(boost::asio::io_context& io, const DaemonConfig& config,
-                                            const JobManager& jobs, RpcServer& rpc) {
+                                            const JobManager& jobs, Uploads& uploads, RpcServer& rpc) {
   const HttpConfig& c = config.http;
   if (!c.host) return nullptr;
   http::HttpSettings s;
@@ -169,7 +170,8 @@ std::unique_ptr<http::HttpServer> start_web(boost::asio::io_context& io, const D
   auto handoff = [&rpc](std::unique_ptr<RpcTransport> transport, const http::Visitor& who, std::string peer) {
     return rpc.adopt(std::move(transport), Via::websocket, who.user, who.role, std::move(peer));
   };
-  auto web = std::make_unique<http::HttpServer>(io, s, http::job_artefacts(jobs), handoff);
+  auto web = std::make_unique<http::HttpServer>(io, s, http::job_artefacts(jobs), handoff,
+                                                http::upload_sink(uploads, config.jobs.max_model_bytes));
   if (auto r = web->listen(); !r) {
     spdlog::error("{}", r.error());
     return nullptr;
@@ -255,7 +257,7 @@ int run(const fs::path& config_path, bool check_only) {
   RpcServer server(io, rs, make_api_handler(jobs, uploads, ServerInfo{kVersion, machine->describe(), config->state_dir.string()}));
   server_ptr = &server;
   // The console before the socket: a client that reaches the socket finds the console up too.
-  std::unique_ptr<http::HttpServer> web = start_web(io, *config, jobs, server);
+  std::unique_ptr<http::HttpServer> web = start_web(io, *config, jobs, uploads, server);
   if (config->http.host && !web) return 1;
   if (!start_listening(server, activated, rs)) return 1;
   if (auto r = jobs.start(); !r) {

@@ -129,19 +129,24 @@ std::expected<std::uint64_t, JobError> Uploads::chunk(const std::string& id, std
   if (!data) return std::unexpected(invalid("params.data: not base64"));
   if (data->empty() || data->size() > limits_.max_chunk_bytes)
     return std::unexpected(invalid(fmt::format("params.data: 1 … {} bytes per chunk", limits_.max_chunk_bytes)));
+  return append(id, offset, *data, now);
+}
+
+std::expected<std::uint64_t, JobError> Uploads::append(const std::string& id, std::uint64_t offset,
+                                                       std::string_view data, Clock::time_point now) {
   std::lock_guard lock(mutex_);
   auto found = find(id, now);
   if (!found) return std::unexpected(found.error());
   Upload& u = **found;
   // In order: the next chunk, or the last one again (a client retrying after a lost reply).
   if (offset > u.received) return std::unexpected(invalid(fmt::format("params.offset: {} leaves a gap (received {})", offset, u.received)));
-  if (offset + data->size() > u.size)
+  if (offset + data.size() > u.size)
     return std::unexpected(invalid(fmt::format("params.offset: the chunk ends past the announced size {}", u.size)));
   std::fstream f(u.path, std::ios::binary | std::ios::in | std::ios::out);
   f.seekp(static_cast<std::streamoff>(offset));
-  f.write(data->data(), static_cast<std::streamsize>(data->size()));
+  f.write(data.data(), static_cast<std::streamsize>(data.size()));
   if (!f) return std::unexpected(JobError{JobErrorKind::storage, fmt::format("writing {} failed", u.path.string())});
-  u.received = std::max(u.received, offset + data->size());
+  u.received = std::max(u.received, offset + data.size());
   u.last_activity = now;
   return u.received;
 }

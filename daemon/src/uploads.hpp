@@ -40,6 +40,9 @@ class Uploads {
   // Returns the bytes received so far.
   std::expected<std::uint64_t, JobError> chunk(const std::string& id, std::uint64_t offset, std::string_view base64,
                                                Clock::time_point now = Clock::now());
+  // The same with the bytes as they are (the web console's POST body, read in pieces).
+  std::expected<std::uint64_t, JobError> append(const std::string& id, std::uint64_t offset, std::string_view bytes,
+                                                Clock::time_point now = Clock::now());
   // The complete file (the upload is forgotten; the caller moves or deletes the file).
   std::expected<std::filesystem::path, JobError> take(const std::string& id, Clock::time_point now = Clock::now());
   // Drops an unfinished (or finished, not yet taken) upload and its file.

@@ -65,6 +65,8 @@ TEST(ConsoleInABrowser, EngineerPlansViewerIsRefusedOperatorCutsEverySheet) {
   });
   EXPECT_EQ(status, 0) << out << "\n--- jobs ---\n" << call_ok(c, "job.list").dump(1) << "\n--- laminad ---\n" << daemon.log();
   EXPECT_NE(out.find("{\"ok\":true"), std::string::npos) << out;
+  // The model came as the form's POST, streamed to disk (not in base64 pieces over the socket).
+  EXPECT_NE(daemon.log().find("http: eng uploads knob.stl ("), std::string::npos) << daemon.log();
   // The browser's hold went down the line as grbl's real-time byte, and the cycle start after it.
   const std::string realtime = lines_with(cell.log(), "\"realtime\"");
   EXPECT_NE(realtime.find("\"command\":\"feed_hold\""), std::string::npos) << realtime;

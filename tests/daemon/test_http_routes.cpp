@@ -80,10 +80,20 @@ TEST(HttpRoutes, TheConsolesFilesAreSafeRelativePaths) {
 TEST(HttpRoutes, TheSessionAndTheLoginHaveTheirOwnPaths) {
   EXPECT_TRUE(std::holds_alternative<SessionRequest>(*route_get("/api/session")));
   EXPECT_EQ(route_get("/api/session/x").error().status, 404);
-  EXPECT_EQ(*route_post("/api/login"), PostRoute::login);
-  EXPECT_EQ(*route_post("/api/logout"), PostRoute::logout);
-  for (const char* other : {"/api/login/", "/api/login?x=1", "/api/jobs", "/", "/api/../api/login"})
+  EXPECT_EQ(route_post("/api/login")->route, PostRoute::login);
+  EXPECT_EQ(route_post("/api/logout")->route, PostRoute::logout);
+  for (const char* other : {"/api/login/", "/api/login?x=1", "/api/jobs", "/", "/api/../api/login", "/api/uploads"})
     EXPECT_EQ(route_post(other).error().status, 404) << other;
+}
+
+TEST(HttpRoutes, AnUploadNamesAPlainFileAndNothingElse) {
+  const auto knob = route_post("/api/uploads?name=knob_v2.stl");
+  ASSERT_TRUE(knob.has_value());
+  EXPECT_EQ(knob->route, PostRoute::upload);
+  EXPECT_EQ(knob->upload_name, "knob_v2.stl");
+  for (const char* bad : {"/api/uploads?name=", "/api/uploads?name=../x.stl", "/api/uploads?name=a/b.stl",
+                          "/api/uploads?name=.hidden.stl", "/api/uploads?name=a%2Fb.stl", "/api/uploads?name=a b.stl"})
+    EXPECT_EQ(route_post(bad).error().status, 400) << bad;
 }
 
 TEST(HttpRoutes, ContentTypesFollowTheExtension) {

@@ -11,6 +11,9 @@
 
 #include "http/http_server.hpp"
 #include "http/passwords.hpp"
+#include "http/upload_sink.hpp"
+#include "rpc_test_support.hpp"
+#include "uploads.hpp"
 #include "http_test_client.hpp"
 #include "lamina/daemon/rpc_server.hpp"
 
@@ -19,6 +22,7 @@ namespace lamina::daemon::http::testing_console {
 // ana is an operator, vic a viewer. Hashes are made once: each takes ~0.1 s by design.
 inline const std::vector<WebUser>& users() {
   static const std::vector<WebUser> u{{"ana", Role::machine_operator, *hash_password("ana's password")},
+                                      {"eve", Role::engineer, *hash_password("eve's password")},
                                       {"vic", Role::viewer, *hash_password("vic's password")}};
   return u;
 }
@@ -28,6 +32,9 @@ struct Console {
   boost::asio::executor_work_guard<boost::asio::io_context::executor_type> work{io.get_executor()};
   std::unique_ptr<RpcServer> rpc;
   std::unique_ptr<HttpServer> web;
+  test::TempDir upload_dir;
+  Uploads uploads{upload_dir.path() / "uploads", UploadLimits{kMaxUploadBytes, 512 << 10, 4, 600}};
+  static constexpr std::uint64_t kMaxUploadBytes = 4 << 20;
   std::thread thread;
 
   // With tls_cert and tls_key set the console is HTTPS only.
@@ -57,7 +64,8 @@ struct Console {
         },
         [this](std::unique_ptr<RpcTransport> t, const Visitor& who, std::string peer) {
           return rpc->adopt(std::move(t), Via::websocket, who.user, who.role, std::move(peer));
-        });
+        },
+        upload_sink(uploads, kMaxUploadBytes));
     if (auto ok = web->listen(); !ok) throw std::runtime_error(ok.error());
     thread = std::thread([this] { io.run(); });
   }

@@ -1,14 +1,37 @@
-// A model sent over the WebSocket in pieces (upload.begin / chunk, docs/api.md), then submitted
-// with the plan settings the form holds. The server checks the settings: its message is shown.
+// A model posted to the daemon (POST /api/uploads, streamed to disk by the server, the
+// engineer's session cookie going with it), then submitted over the WebSocket with the plan
+// settings the form holds. The server checks both: its message is what the person sees.
 import type { Rpc } from "./rpc";
 import type { Job } from "./types";
 
-const kChunkBytes = 384 * 1024;  // under the server's 512 KiB decoded, and its 1 MiB request line
+// Only the extension matters to the server (the model's format); the job keeps the real name.
+function plainName(name: string): string {
+  const cleaned = name.replace(/[^A-Za-z0-9._-]/g, "_").replace(/^\.+/, "");
+  return cleaned.length > 0 ? cleaned.slice(-200) : "model.stl";
+}
 
-function base64(bytes: Uint8Array): string {
-  let text = "";
-  for (let i = 0; i < bytes.length; i += 0x8000) text += String.fromCharCode(...bytes.subarray(i, i + 0x8000));
-  return btoa(text);
+// XMLHttpRequest rather than fetch: it reports the upload's progress.
+function post(file: File, onProgress: (fraction: number) => void): Promise<string> {
+  return new Promise((resolve, reject) => {
+    const xhr = new XMLHttpRequest();
+    xhr.open("POST", `/api/uploads?name=${plainName(file.name)}`);
+    xhr.setRequestHeader("Content-Type", "application/octet-stream");
+    xhr.upload.onprogress = (e) => {
+      if (e.lengthComputable && e.total > 0) onProgress(e.loaded / e.total);
+    };
+    xhr.onerror = () => reject(new Error("the upload was cut off"));
+    xhr.onload = () => {
+      let reply: { upload?: string; error?: string } = {};
+      try {
+        reply = JSON.parse(xhr.responseText);
+      } catch {
+        // a proxy's page, or nothing: the status says enough
+      }
+      if (xhr.status === 200 && reply.upload) resolve(reply.upload);
+      else reject(new Error(reply.error ?? `the upload was refused (HTTP ${xhr.status})`));
+    };
+    xhr.send(file);
+  });
 }
 
 export async function uploadAndSubmit(
@@ -17,13 +40,8 @@ export async function uploadAndSubmit(
   settings: Record<string, unknown>,
   onProgress: (fraction: number) => void,
 ): Promise<Job> {
-  const data = new Uint8Array(await file.arrayBuffer());
-  const { upload } = await rpc.call<{ upload: string }>("upload.begin", { name: file.name, size: data.length });
+  const upload = await post(file, onProgress);
   try {
-    for (let offset = 0; offset < data.length; offset += kChunkBytes) {
-      await rpc.call("upload.chunk", { upload, offset, data: base64(data.subarray(offset, offset + kChunkBytes)) });
-      onProgress(Math.min(1, (offset + kChunkBytes) / data.length));
-    }
     return await rpc.call<Job>("job.submit", { upload, name: file.name, settings });
   } catch (e) {
     await rpc.call("upload.cancel", { upload }).catch(() => undefined);

@@ -1,5 +1,7 @@
 #include "http/http_routes.hpp"
 
+#include <algorithm>
+
 #include <array>
 #include <charconv>
 #include <vector>
@@ -101,10 +103,18 @@ std::expected<Route, RouteError> route_get(std::string_view target) {
   return StaticRequest{relative};
 }
 
-std::expected<PostRoute, RouteError> route_post(std::string_view target) {
-  if (target == "/api/login") return PostRoute::login;
-  if (target == "/api/logout") return PostRoute::logout;
-  return std::unexpected(RouteError{404, "POST is served at /api/login and /api/logout only"});
+std::expected<PostRequest, RouteError> route_post(std::string_view target) {
+  if (target == "/api/login") return PostRequest{PostRoute::login, {}};
+  if (target == "/api/logout") return PostRequest{PostRoute::logout, {}};
+  constexpr std::string_view upload = "/api/uploads?name=";
+  if (target.starts_with(upload)) {
+    // Only the extension matters (the model's format); the job's own name goes with job.submit.
+    const std::string_view name = target.substr(upload.size());
+    if (name.empty() || name.size() > 200 || name.front() == '.' || !std::all_of(name.begin(), name.end(), plain_char))
+      return std::unexpected(RouteError{400, "name: a plain file name of [A-Za-z0-9._-], e.g. part.stl"});
+    return PostRequest{PostRoute::upload, std::string(name)};
+  }
+  return std::unexpected(RouteError{404, "POST is served at /api/login, /api/logout and /api/uploads?name=… only"});
 }
 
 std::string artefact_file_name(const ArtefactRequest& request) {

@@ -26,7 +26,12 @@ struct StaticRequest {       // anything else: a file of the console ("/" is ind
 };
 using Route = std::variant<ArtefactRequest, WebSocketRequest, SessionRequest, StaticRequest>;
 
-enum class PostRoute : std::uint8_t { login, logout };  // POST /api/login, /api/logout
+// POST /api/login, /api/logout, /api/uploads?name=<file name> (a model, the body its bytes).
+enum class PostRoute : std::uint8_t { login, logout, upload };
+struct PostRequest {
+  PostRoute route = PostRoute::login;
+  std::string upload_name;  // plain characters ([A-Za-z0-9._-]), not starting with '.'
+};
 
 struct RouteError {
   int status = 400;  // HTTP status: 400 (malformed), 404 (no such thing)
@@ -34,7 +39,7 @@ struct RouteError {
 };
 
 std::expected<Route, RouteError> route_get(std::string_view target);
-std::expected<PostRoute, RouteError> route_post(std::string_view target);
+std::expected<PostRequest, RouteError> route_post(std::string_view target);
 
 // The artefact's file name in the job's folder ("sheet-2.svg"); the model is the job's own path.
 std::string artefact_file_name(const ArtefactRequest& request);

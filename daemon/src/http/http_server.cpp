@@ -14,11 +14,13 @@ namespace lamina::daemon::http {
 namespace asio = boost::asio;
 using tcp = asio::ip::tcp;
 
-HttpServer::Impl::Impl(asio::io_context& io_context, HttpSettings s, ArtefactLookup lookup, WebSocketHandoff ws)
+HttpServer::Impl::Impl(asio::io_context& io_context, HttpSettings s, ArtefactLookup lookup, WebSocketHandoff ws,
+                       UploadSink upload_sink)
     : io(io_context),
       settings(std::move(s)),
       artefacts(std::move(lookup)),
       websockets(std::move(ws)),
+      uploads(std::move(upload_sink)),
       access(settings.access),
       acceptor(io_context) {
   if (access.users_configured()) dummy_hash = hash_password(random_token()).value_or("");
@@ -56,8 +58,9 @@ void HttpServer::Impl::close_all() {
 }
 
 HttpServer::HttpServer(asio::io_context& io, HttpSettings settings, ArtefactLookup artefacts,
-                       WebSocketHandoff websockets)
-    : impl_(std::make_shared<Impl>(io, std::move(settings), std::move(artefacts), std::move(websockets))) {}
+                       WebSocketHandoff websockets, UploadSink uploads)
+    : impl_(std::make_shared<Impl>(io, std::move(settings), std::move(artefacts), std::move(websockets),
+                                   std::move(uploads))) {}
 
 HttpServer::~HttpServer() { stop(); }
 

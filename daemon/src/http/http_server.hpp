@@ -41,9 +41,19 @@ using ArtefactLookup = std::function<std::expected<std::filesystem::path, RouteE
 using WebSocketHandoff =
     std::function<std::expected<void, std::string>(std::unique_ptr<RpcTransport>, const Visitor&, std::string peer)>;
 
+// Where POST /api/uploads puts a model (laminad: its Uploads, the same as upload.begin/chunk):
+// an upload id the browser then names in job.submit. Errors carry their HTTP status.
+struct UploadSink {
+  std::function<std::expected<std::string, RouteError>(const std::string& name, std::uint64_t size)> begin;
+  std::function<std::expected<void, RouteError>(const std::string& id, std::uint64_t offset, std::string_view bytes)> append;
+  std::function<void(const std::string& id)> cancel;
+  std::uint64_t max_bytes = 0;  // a larger Content-Length is refused (413) before its body is read
+};
+
 class HttpServer {
  public:
-  HttpServer(boost::asio::io_context& io, HttpSettings settings, ArtefactLookup artefacts, WebSocketHandoff websockets);
+  HttpServer(boost::asio::io_context& io, HttpSettings settings, ArtefactLookup artefacts, WebSocketHandoff websockets,
+             UploadSink uploads = {});
   ~HttpServer();
   HttpServer(const HttpServer&) = delete;
   HttpServer& operator=(const HttpServer&) = delete;

@@ -29,12 +29,14 @@ class HttpConnection {
 };
 
 struct HttpServer::Impl : std::enable_shared_from_this<HttpServer::Impl> {
-  Impl(boost::asio::io_context& io_context, HttpSettings s, ArtefactLookup lookup, WebSocketHandoff ws);
+  Impl(boost::asio::io_context& io_context, HttpSettings s, ArtefactLookup lookup, WebSocketHandoff ws,
+       UploadSink upload_sink);
 
   boost::asio::io_context& io;
   HttpSettings settings;
   ArtefactLookup artefacts;
   WebSocketHandoff websockets;
+  UploadSink uploads;
   WebAccess access;
   PasswordChecker passwords;
   std::string dummy_hash;  // unknown names are checked against this: a wrong name costs a wrong password's time

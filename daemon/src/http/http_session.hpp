@@ -10,6 +10,7 @@
 #include <string_view>
 #include <type_traits>
 #include <variant>
+#include <vector>
 
 #include <boost/asio/ssl.hpp>
 #include <boost/beast/core.hpp>
@@ -97,19 +98,26 @@ class Session final : public HttpConnection, public std::enable_shared_from_this
   void read_next() {
     parser_.emplace();
     parser_->header_limit(static_cast<std::uint32_t>(server_->settings.max_header_bytes));
-    parser_->body_limit(kMaxLoginBody);  // checked against Content-Length as the head ends
+    // Checked against Content-Length as the head ends: the largest body any route takes (an
+    // upload); on_header narrows it to the route's own.
+    parser_->body_limit(std::max<std::uint64_t>(kMaxLoginBody, server_->uploads.max_bytes));
     lowest().expires_after(idle());
     bhttp::async_read_header(stream_, buffer_, *parser_,
                              [self = this->shared_from_this()](beast::error_code ec, std::size_t) { self->on_header(ec); });
   }
 
-  // Only the login has a body (a few hundred bytes of JSON); anything else with one is refused.
+  // Only the login (a few hundred bytes of JSON) and an upload (streamed to disk) have a body;
+  // anything else with one is refused.
   void on_header(beast::error_code ec) {
     if (ec) return on_read(ec);
     const bool post = parser_->get().method() == bhttp::verb::post;
+    if (post && parser_->get().target().starts_with("/api/uploads")) return start_upload();
     const auto length = parser_->content_length();
     if (!post && ((length && *length > 0) || parser_->chunked())) return on_read(bhttp::error::body_limit);
-    parser_->body_limit(post ? kMaxLoginBody : 0);  // a chunked body is counted as it comes
+    // Beast checked Content-Length against the upload's limit as the head ended: the login's
+    // is checked here, and a chunked body is counted against it as it comes.
+    if (length && *length > kMaxLoginBody) return on_read(bhttp::error::body_limit);
+    parser_->body_limit(post ? kMaxLoginBody : 0);
     bhttp::async_read(stream_, buffer_, *parser_,
                       [self = this->shared_from_this()](beast::error_code e, std::size_t) { self->on_read(e); });
   }
@@ -194,11 +202,77 @@ class Session final : public HttpConnection, public std::enable_shared_from_this
     // A form another site's page posts (CSRF): the browser says whose page it is.
     if (auto origin = server_->access.check_origin(field(bhttp::field::origin), field(bhttp::field::host)); !origin)
       return send_json(bhttp::status::forbidden, {{"error", origin.error().message}});
-    if (*route == PostRoute::logout) {
+    if (route->route == PostRoute::logout) {
       server_->access.sessions().close(cookie_value(field(bhttp::field::cookie), kSessionCookie));
       return send_json(bhttp::status::ok, {{"logged_out", true}}, server_->access.cleared_cookie());
     }
     login(req.body());
+  }
+
+  // --- POST /api/uploads?name=…: a model, its bytes the body (Content-Length required) ---
+  // Checked before a byte of the body is read: the Host, the Origin, an engineer's session, the
+  // size. Then read in 256 KiB pieces, each appended to the upload's file as it comes.
+  void start_upload() {
+    keep_alive_ = false;  // an upload's connection closes after its answer (a refused body is never read)
+    const auto& req = parser_->get();
+    if (auto host = server_->access.check_host(field(bhttp::field::host)); !host) return refuse(host.error());
+    auto route = route_post(std::string_view(req.target().data(), req.target().size()));
+    if (!route) return send_json(static_cast<bhttp::status>(route.error().status), {{"error", route.error().message}});
+    if (auto origin = server_->access.check_origin(field(bhttp::field::origin), field(bhttp::field::host)); !origin)
+      return send_json(bhttp::status::forbidden, {{"error", origin.error().message}});
+    auto who = visitor();
+    if (!who) return send_json(static_cast<bhttp::status>(who.error().status), {{"error", who.error().message}});
+    if (who->role < Role::engineer)
+      return send_json(bhttp::status::forbidden, {{"error", fmt::format("uploading a model is for an engineer; {} is {}",
+                                                                         who->user, article_role(who->role))}});
+    const UploadSink& sink = server_->uploads;
+    if (!sink.begin) return send_json(bhttp::status::not_found, {{"error", "uploads are not taken here"}});
+    const auto length = parser_->content_length();
+    if (!length || parser_->chunked())
+      return send_json(bhttp::status::length_required, {{"error", "an upload needs its Content-Length"}});
+    if (*length == 0 || *length > sink.max_bytes)
+      return send_json(bhttp::status::payload_too_large, {{"error", fmt::format("a model is 1 … {} bytes; this is {}", sink.max_bytes, *length)}});
+    auto id = sink.begin(route->upload_name, *length);
+    if (!id) return send_json(static_cast<bhttp::status>(id.error().status), {{"error", id.error().message}});
+    upload_id_ = *id;
+    upload_parser_.emplace(std::move(*parser_));
+    upload_parser_->body_limit(*length);
+    spdlog::info("http: {} uploads {} ({} bytes) from {}", who->user, route->upload_name, *length, address_);
+    read_upload();
+  }
+
+  void read_upload() {
+    upload_chunk_.resize(256 * 1024);
+    auto& body = upload_parser_->get().body();
+    body.data = upload_chunk_.data();
+    body.size = upload_chunk_.size();
+    lowest().expires_after(idle());  // a sender that stalls is dropped, and its upload with it
+    bhttp::async_read(stream_, buffer_, *upload_parser_,
+                      [self = this->shared_from_this()](beast::error_code ec, std::size_t) { self->on_upload_read(ec); });
+  }
+
+  void on_upload_read(beast::error_code ec) {
+    if (ec == bhttp::error::need_buffer) ec = {};
+    const std::size_t got = upload_chunk_.size() - upload_parser_->get().body().size;
+    if (!ec && got > 0) {
+      auto ok = server_->uploads.append(upload_id_, upload_received_, std::string_view(upload_chunk_.data(), got));
+      if (!ok) {
+        server_->uploads.cancel(upload_id_);
+        return send_json(static_cast<bhttp::status>(ok.error().status), {{"error", ok.error().message}});
+      }
+      upload_received_ += got;
+    }
+    if (ec) {  // the sender went away or stalled: what came is dropped, not left as a half model
+      spdlog::warn("http: upload from {} ended after {} bytes: {}", peer_, upload_received_, ec.message());
+      server_->uploads.cancel(upload_id_);
+      return finish();
+    }
+    if (!upload_parser_->is_done()) return read_upload();
+    send_json(bhttp::status::ok, {{"upload", upload_id_}, {"size", upload_received_}});
+  }
+
+  static std::string article_role(Role role) {
+    return role == Role::machine_operator ? "an operator" : fmt::format("a {}", role_name(role));
   }
 
   void login(const std::string& body) {
@@ -314,6 +388,10 @@ class Session final : public HttpConnection, public std::enable_shared_from_this
   Stream stream_;
   beast::flat_buffer buffer_;
   std::optional<bhttp::request_parser<bhttp::string_body>> parser_;
+  std::optional<bhttp::request_parser<bhttp::buffer_body>> upload_parser_;
+  std::vector<char> upload_chunk_;
+  std::string upload_id_;
+  std::uint64_t upload_received_ = 0;
   std::shared_ptr<HttpServer::Impl> server_;
   std::uint64_t id_;
   std::string address_, peer_;  // the client's IP (the login limiter's key), and with its port
