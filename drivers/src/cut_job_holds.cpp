@@ -124,7 +124,8 @@ void CutJob::watch_holds() {
       case detail::HoldAction::jet_on:
         if (!cell_) return;
         spdlog::info("cut: resuming the hold: jet and abrasive on, motion in {:.1f} s", settings_.jet_restart_s);
-        if (auto r = cell_->restore_jet(); !r) stop_job(r.error());
+        if (auto r = cell_->restore_jet(); !r) return stop_job(r.error());
+        guard.on_jet_opened(std::chrono::duration<double>(Clock::now() - t0).count());
         return;
       case detail::HoldAction::cycle_start:
         link_.request(RealtimeCommand::resume);

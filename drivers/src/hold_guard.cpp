@@ -66,4 +66,8 @@ HoldAction HoldGuard::on_resume_request(double now_s) {
   return HoldAction::jet_on;
 }
 
+void HoldGuard::on_jet_opened(double now_s) {
+  if (restart_at_s_ && !cycle_started_) restart_at_s_ = now_s + settings_.jet_restart_s;
+}
+
 }  // namespace lamina::drivers::detail

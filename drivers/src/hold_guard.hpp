@@ -43,6 +43,10 @@ class HoldGuard {
   // by the hold (then on_state() says cycle_start after the restart time), cycle_start when it
   // was never off (a hold still decelerating, or no jet to restore).
   HoldAction on_resume_request(double now_s);
+  // The PLC has taken the jet-on (restore_jet returned): the restart time counts from here, not
+  // from the request. A busy PLC or bus may take a while to open the jet, and the jet must have
+  // its whole restart time before the motion (the simulator's log once showed 499.9 ms of 500).
+  void on_jet_opened(double now_s);
   // The machine stands Idle mid-program with the water on (starvation_watch.hpp): starved_hold,
   // once, unless a hold already has the jet off. It is then held as after any hold: the
   // operator's resume opens the jet and continues. An Idle machine counts as standing in it

@@ -37,6 +37,19 @@ TEST(HoldGuard, ResumeOpensTheJetWaitsItsRestartTimeThenContinues) {
   EXPECT_EQ(g.on_state(S::hold, 20.0), HoldAction::jet_off);
 }
 
+// The restart time runs from the PLC's confirmation: a jet-on that took 0.4 s to reach the PLC
+// still gets its whole 1.5 s before the motion.
+TEST(HoldGuard, TheRestartTimeCountsFromTheJetOpeningNotFromTheRequest) {
+  auto g = guard(60, 1.5);
+  g.on_state(S::hold, 0.0);
+  EXPECT_EQ(g.on_resume_request(10.0), HoldAction::jet_on);
+  g.on_jet_opened(10.4);
+  EXPECT_EQ(g.on_state(S::hold, 11.5), HoldAction::none) << "1.5 s after the request, 1.1 s after the jet opened";
+  EXPECT_EQ(g.on_state(S::hold, 11.9), HoldAction::cycle_start);
+  g.on_jet_opened(12.5);  // late news changes nothing once the motion was asked for
+  EXPECT_EQ(g.on_state(S::hold, 12.6), HoldAction::none);
+}
+
 TEST(HoldGuard, AResumeBeforeTheHoldCompletedIsAPlainCycleStart) {
   auto g = guard();
   g.on_state(S::hold_pending, 0.0);
