@@ -238,8 +238,9 @@ RpcServer::Handler make_api_handler(JobManager& jobs, Uploads& uploads, ServerIn
     // Refused out loud, never ignored: the console shows this message to the person who pressed.
     if (client.role < it->second.role)
       return std::unexpected(RpcError{rpc_code::forbidden,
-                                      fmt::format("{} is for an {} or above; {} is a {}", request.method,
-                                                  role_name(it->second.role), client.user, role_name(client.role)),
+                                      fmt::format("{} is for {} or above; {} is {}", request.method,
+                                                  role_with_article(it->second.role), client.user,
+                                                  role_with_article(client.role)),
                                       Json{{"needs", role_name(it->second.role)}, {"role", role_name(client.role)}}});
     return it->second.call(request.params, client);
   };

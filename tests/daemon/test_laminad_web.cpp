@@ -92,7 +92,9 @@ TEST(LaminadWeb, AViewerIsRefusedOutLoudAndAnOperatorsConfirmIsInTheJobsEvents) 
 
   WsClient op(port, http_login(port, "ana", "a-pass"), origin);
   ASSERT_TRUE(op.open());
-  EXPECT_EQ(op.call("job.cancel", {{"job", id}})["error"]["code"], rpc_code::forbidden) << "cancel is an engineer's";
+  const Json cancel = op.call("job.cancel", {{"job", id}});
+  EXPECT_EQ(cancel["error"]["code"], rpc_code::forbidden) << "cancel is an engineer's";
+  EXPECT_EQ(cancel["error"]["message"], "job.cancel is for an engineer or above; ana is an operator");  // not "a operator"
   const Json confirmed = op.call("job.confirm_sheet", {{"job", id}, {"sheet", 1}});
   ASSERT_TRUE(confirmed.contains("result")) << confirmed.dump() << daemon.log();
 

@@ -197,11 +197,8 @@ class Session final : public HttpConnection, public std::enable_shared_from_this
   // --- POST: the login and the logout (their bodies and answers are JSON) ---
   void on_post() {
     const auto& req = parser_->get();
-    auto route = route_post(std::string_view(req.target().data(), req.target().size()));
-    if (!route) return send_json(static_cast<bhttp::status>(route.error().status), {{"error", route.error().message}});
-    // A form another site's page posts (CSRF): the browser says whose page it is.
-    if (auto origin = server_->access.check_origin(field(bhttp::field::origin), field(bhttp::field::host)); !origin)
-      return send_json(bhttp::status::forbidden, {{"error", origin.error().message}});
+    auto route = checked_post();
+    if (!route) return;
     if (route->route == PostRoute::logout) {
       server_->access.sessions().close(cookie_value(field(bhttp::field::cookie), kSessionCookie));
       return send_json(bhttp::status::ok, {{"logged_out", true}}, server_->access.cleared_cookie());
@@ -209,22 +206,35 @@ class Session final : public HttpConnection, public std::enable_shared_from_this
     login(req.body());
   }
 
+  // Every POST's route and Origin (a form another site's page posts, CSRF: the browser says
+  // whose page it is); nullopt when refused, the answer sent.
+  std::optional<PostRequest> checked_post() {
+    const auto& req = parser_->get();
+    auto route = route_post(std::string_view(req.target().data(), req.target().size()));
+    if (!route) {
+      send_json(static_cast<bhttp::status>(route.error().status), {{"error", route.error().message}});
+      return std::nullopt;
+    }
+    if (auto origin = server_->access.check_origin(field(bhttp::field::origin), field(bhttp::field::host)); !origin) {
+      send_json(bhttp::status::forbidden, {{"error", origin.error().message}});
+      return std::nullopt;
+    }
+    return *route;
+  }
+
   // --- POST /api/uploads?name=…: a model, its bytes the body (Content-Length required) ---
   // Checked before a byte of the body is read: the Host, the Origin, an engineer's session, the
   // size. Then read in 256 KiB pieces, each appended to the upload's file as it comes.
   void start_upload() {
     keep_alive_ = false;  // an upload's connection closes after its answer (a refused body is never read)
-    const auto& req = parser_->get();
     if (auto host = server_->access.check_host(field(bhttp::field::host)); !host) return refuse(host.error());
-    auto route = route_post(std::string_view(req.target().data(), req.target().size()));
-    if (!route) return send_json(static_cast<bhttp::status>(route.error().status), {{"error", route.error().message}});
-    if (auto origin = server_->access.check_origin(field(bhttp::field::origin), field(bhttp::field::host)); !origin)
-      return send_json(bhttp::status::forbidden, {{"error", origin.error().message}});
+    auto route = checked_post();
+    if (!route) return;
     auto who = visitor();
     if (!who) return send_json(static_cast<bhttp::status>(who.error().status), {{"error", who.error().message}});
     if (who->role < Role::engineer)
       return send_json(bhttp::status::forbidden, {{"error", fmt::format("uploading a model is for an engineer; {} is {}",
-                                                                         who->user, article_role(who->role))}});
+                                                                         who->user, role_with_article(who->role))}});
     const UploadSink& sink = server_->uploads;
     if (!sink.begin) return send_json(bhttp::status::not_found, {{"error", "uploads are not taken here"}});
     const auto length = parser_->content_length();
@@ -269,10 +279,6 @@ class Session final : public HttpConnection, public std::enable_shared_from_this
     }
     if (!upload_parser_->is_done()) return read_upload();
     send_json(bhttp::status::ok, {{"upload", upload_id_}, {"size", upload_received_}});
-  }
-
-  static std::string article_role(Role role) {
-    return role == Role::machine_operator ? "an operator" : fmt::format("a {}", role_name(role));
   }
 
   void login(const std::string& body) {

@@ -12,6 +12,7 @@ namespace lamina::daemon {
 enum class Role : std::uint8_t { viewer, machine_operator, engineer };  // each may do what the one before may
 
 const char* role_name(Role role);  // "viewer", "operator", "engineer"
+const char* role_with_article(Role role);  // "a viewer", "an operator", "an engineer" (refusals)
 std::optional<Role> role_from_name(std::string_view name);
 
 }  // namespace lamina::daemon
