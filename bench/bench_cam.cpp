@@ -48,7 +48,7 @@ const SpherePlan& sphere() {
     auto parts = lamina::make_parts(out.plan, lamina::PartParams{});
     if (!parts) die(parts.error().message);
     out.parts = std::move(*parts);
-    for (double t : {1.0, 2.5, 5.0, 10.0}) out.stock.sheets.push_back({t, 1250.0, 2500.0, 0, "aluminium 6061-T6"});
+    for (double t : {1.0, 2.5, 5.0, 10.0}) out.stock.sheets.push_back({t, 1250.0, 2500.0, 0, "aluminium 6061-T6", ""});
     out.material.name = "aluminium 6061-T6";
     out.material.specific_energy_j_per_m3 = 7.7e9;
     out.material.machinability = 213;

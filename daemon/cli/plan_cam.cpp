@@ -106,7 +106,8 @@ void print_sheet_table(std::FILE* out, const PlanReport& report) {
     fmt::print(out, "{:>5} {:>6.3g} {:>11} {:>5} {:>6.1f} {:>7} {:>9.2f} {:>5}:{:02} {:>9} {:>7}  {}\n", s.index,
                s.thickness_mm, fmt::format("{:g}x{:g}", s.length_mm, s.width_mm), s.parts.size(),
                100.0 * s.utilisation, s.pierces, s.cut_length_mm / 1000.0, static_cast<int>(t) / 60,
-               static_cast<int>(t) % 60, s.program_bytes, b ? fmt::format("{:.1f}", *b) : "-", s.material);
+               static_cast<int>(t) % 60, s.program_bytes, b ? fmt::format("{:.1f}", *b) : "-",
+               s.slot ? fmt::format("{} (slot {})", s.material, *s.slot) : s.material);
   }
   const ReportCam& c = *report.cam;
   fmt::print(out, "  {} sheets, {} parts, estimated cutting {}:{:02}:{:02} (h:m:s); {} nesting, {} post{}\n",

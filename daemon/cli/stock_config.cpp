@@ -3,13 +3,15 @@
 #include <fmt/format.h>
 #include "toml_file.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <optional>
 
 namespace lamina::cli {
 namespace {
 
-constexpr std::string_view kKnownKeys = "thickness_mm, width_mm, length_mm, count, material";
+constexpr std::string_view kKnownKeys = "thickness_mm, width_mm, length_mm, count, material, slot";
+constexpr std::size_t kMaxSlotChars = 40;  // a label on the rack, shown big on the operator's prompt
 
 // A length in mm: a TOML integer or float, finite, >= 0 (> 0 when `positive`).
 std::expected<double, Error> length_mm(const std::string& source, std::string_view key, const toml::node& node,
@@ -43,6 +45,13 @@ std::expected<SheetStock, Error> read_sheet(const std::string& source, const tom
       const auto* m = node.as_string();
       if (!m) return std::unexpected(toml_error(source, node.source(), "material must be a string"));
       s.material = m->get();
+    } else if (k == "slot") {
+      const auto* slot = node.as_string();
+      const bool printable = slot && std::ranges::none_of(slot->get(), [](unsigned char c) { return c < 0x20 || c == 0x7f; });
+      if (!slot || slot->get().empty() || slot->get().size() > kMaxSlotChars || !printable)
+        return std::unexpected(toml_error(source, node.source(),
+                                          fmt::format("slot must be a rack label of 1 … {} printable characters", kMaxSlotChars)));
+      s.slot = slot->get();
     } else {
       return std::unexpected(
           toml_error(source, key.source(), fmt::format("unknown key '{}' in [[sheet]] (known: {})", k, kKnownKeys)));

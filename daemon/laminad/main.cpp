@@ -32,6 +32,7 @@
 #include "lamina/daemon/rpc_server.hpp"
 #include "lamina/daemon/systemd_integration.hpp"
 #include "machine_session.hpp"
+#include "warning_log.hpp"
 
 namespace fs = std::filesystem;
 using namespace lamina::daemon;
@@ -50,14 +51,19 @@ fs::path find_lamina(const std::string& configured) {
   return "/usr/bin/lamina";
 }
 
-void setup_logging() {
+// Every logger of laminad (its own and the drivers') writes to stderr (the journal) and to the
+// warning log the console shows; made here, before anything asks for one by name.
+std::shared_ptr<WarningLog> setup_logging() {
   // Under systemd the journal stamps each line; elsewhere the time helps.
   const bool journal = std::getenv("JOURNAL_STREAM") != nullptr;
   spdlog::set_pattern(journal ? "[%n] %l: %v" : "%Y-%m-%d %H:%M:%S.%e [%n] %l: %v");
+  auto warnings = std::make_shared<WarningLog>();
   auto main_logger = spdlog::stderr_color_mt("laminad");
+  main_logger->sinks().push_back(warnings);
   spdlog::set_default_logger(main_logger);
-  for (const char* name : {"jobs", "cut", "rpc", "store"})
+  for (const char* name : {"jobs", "cut", "rpc", "store", "cell", "modbus-link"})
     if (!spdlog::get(name)) spdlog::register_logger(main_logger->clone(name));
+  return warnings;
 }
 
 template <typename F>
@@ -218,7 +224,7 @@ void serve(boost::asio::io_context& io, boost::asio::signal_set& signals, RpcSer
   if (stopper.joinable()) stopper.join();
 }
 
-int run(const fs::path& config_path, bool check_only) {
+int run(const fs::path& config_path, bool check_only, std::shared_ptr<const WarningLog> warnings) {
   auto config = load_daemon_config(config_path);
   if (!config) {
     spdlog::error("{}", config.error().message);
@@ -254,7 +260,7 @@ int run(const fs::path& config_path, bool check_only) {
   });
   Uploads uploads(config->state_dir / "uploads", UploadLimits{config->jobs.max_model_bytes, UploadLimits{}.max_chunk_bytes,
                                                                config->jobs.max_uploads, config->jobs.upload_idle_s});
-  RpcServer server(io, rs, make_api_handler(jobs, uploads, ServerInfo{kVersion, machine->describe(), config->state_dir.string()}));
+  RpcServer server(io, rs, make_api_handler(jobs, uploads, ServerInfo{kVersion, machine->describe(), config->state_dir.string(), warnings}));
   server_ptr = &server;
   // The console before the socket: a client that reaches the socket finds the console up too.
   std::unique_ptr<http::HttpServer> web = start_web(io, *config, jobs, uploads, server);
@@ -316,9 +322,9 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("laminad ") + kVersion);
   CLI11_PARSE(app, argc, argv);
   if (hash) return print_password_hash();
-  setup_logging();
+  auto warnings = setup_logging();
   try {
-    return run(config_path, check);
+    return run(config_path, check, warnings);
   } catch (const std::exception& e) {  // start-up failures only: the running daemon reports errors as data
     spdlog::critical("{}", e.what());
     return 1;

@@ -3,6 +3,7 @@
 #include "plan_settings.hpp"
 
 #include <functional>
+#include <limits>
 #include <map>
 
 #include <fmt/format.h>
@@ -196,6 +197,25 @@ void add_job_methods(MethodTable& m, JobManager& jobs, Uploads& uploads) {
       });
 }
 
+// server.warnings {since?}: what laminad warned about (every logger's warnings and errors, the
+// last 200), those after `since` (a seq from an earlier answer). `last` is the newest seq, so a
+// client that polls asks for what it has not seen.
+RpcResult warnings_since(const WarningLog* log, const Json& params) {
+  std::uint64_t after = 0;
+  if (params.is_object() && params.contains("since")) {
+    auto since = int_param(params, "since", 0, std::numeric_limits<int>::max());
+    if (!since) return std::unexpected(since.error());
+    after = static_cast<std::uint64_t>(*since);
+  }
+  Json list = Json::array();
+  std::uint64_t last = after;
+  for (const LoggedWarning& w : log ? log->since(after) : std::vector<LoggedWarning>{}) {
+    list.push_back({{"seq", w.seq}, {"t_unix_ms", w.t_unix_ms}, {"level", w.level}, {"source", w.source}, {"message", w.message}});
+    last = w.seq;
+  }
+  return Json{{"warnings", list}, {"last", last}};
+}
+
 // machine.*: the machine, whichever job has it.
 void add_machine_methods(MethodTable& m, JobManager& jobs) {
   m["machine.status"] = {Role::viewer, [&jobs](const Json&, ClientContext&) -> RpcResult { return jobs.machine_status(); }};
@@ -228,6 +248,9 @@ RpcServer::Handler make_api_handler(JobManager& jobs, Uploads& uploads, ServerIn
                              return Json{{"subscribed", true},
                                          {"notifications", {"notify_job_progress", "notify_machine_status"}}};
                            }};
+  m["server.warnings"] = {Role::viewer, [log = info.warnings](const Json& params, ClientContext&) -> RpcResult {
+                            return warnings_since(log.get(), params);
+                          }};
   add_upload_methods(m, uploads);
   add_job_methods(m, jobs, uploads);
   add_machine_methods(m, jobs);

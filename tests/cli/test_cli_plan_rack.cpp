@@ -109,4 +109,47 @@ TEST(CliPlanRack, ARackThatCannotMakeTheStackSaysWhichThicknessRunsOut) {
   EXPECT_NE(small.out.find("no larger than 29 x 29 mm"), std::string::npos) << small.out;
 }
 
+// Where each sheet lies on the rack (issue 19: the operator's prompt names the slot): a stock
+// entry's `slot` goes to every sheet cut from it, in the report and the sheet table.
+TEST(CliPlanRack, EverySheetSaysWhichRackSlotItComesFrom) {
+  TempDir dir("plan-rack-slots");
+  std::ofstream(dir.path / "cone.stl") << cone_stl();
+  // One 5 mm sheet that holds one layer (as above): the rest of the cone comes from the 2.5 mm entry.
+  std::ofstream(dir.path / "rack.toml") << sheet(2.5, 400, 4) + "slot = \"R2 left\"\n" + sheet(5.0, 110, 1) + "slot = \"R7\"\n";
+  const auto r = lamina("plan " + quoted(dir.path / "cone.stl") + " --stock-file " + quoted(dir.path / "rack.toml") +
+                        " --out " + quoted(dir.path / "out"));
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  const json j = read_report(dir.path / "out");
+  ASSERT_EQ(j["settings"]["stock"].size(), 2u);
+  EXPECT_EQ(j["settings"]["stock"][0]["slot"], "R2 left");
+  EXPECT_EQ(j["settings"]["stock"][1]["slot"], "R7");
+  std::map<double, int> sheets;
+  for (const json& s : j["sheets"]) {
+    ++sheets[s["thickness_mm"].get<double>()];
+    EXPECT_EQ(s.value("slot", ""), s["thickness_mm"].get<double>() == 5.0 ? "R7" : "R2 left") << s.dump();
+  }
+  EXPECT_GT(sheets.size(), 1u) << "both entries must be cut from: " << j["sheets"].dump();
+  EXPECT_NE(r.out.find("(slot R7)"), std::string::npos) << r.out;
+
+  // No slot given: no key in the report (and reports without one still read: PlanReportJson).
+  const auto plain = lamina("plan " + quoted(dir.path / "cone.stl") + " --stock 5 --out " + quoted(dir.path / "plain"));
+  ASSERT_EQ(plain.exit_code, 0) << plain.out;
+  for (const json& s : read_report(dir.path / "plain")["sheets"]) EXPECT_FALSE(s.contains("slot")) << s.dump();
+}
+
+TEST(CliPlanRack, ASlotThatIsNoLabelIsRefusedWithItsLine) {
+  TempDir dir("plan-rack-bad-slot");
+  std::ofstream(dir.path / "cone.stl") << cone_stl();
+  for (const std::string& bad : {std::string("slot = \"\""), std::string("slot = 3"), std::string("slot = \"") + std::string(41, 'x') + "\"",
+                                 std::string("slot = \"R1\\u0007\"")}) {
+    std::ofstream(dir.path / "rack.toml") << sheet(5.0, 400, 4) + bad + "\n";
+    const auto r = lamina("plan " + quoted(dir.path / "cone.stl") + " --stock-file " + quoted(dir.path / "rack.toml") +
+                          " --out " + quoted(dir.path / "out"));
+    EXPECT_EQ(r.exit_code, 1) << bad << "\n" << r.out;
+    EXPECT_NE(r.out.find("rack.toml:6"), std::string::npos) << bad << "\n" << r.out;
+    EXPECT_NE(r.out.find("slot must be a rack label of 1 … 40 printable characters"), std::string::npos) << bad << "\n" << r.out;
+    EXPECT_FALSE(fs::exists(dir.path / "out"));
+  }
+}
+
 }  // namespace

@@ -56,10 +56,17 @@ TEST(ConsoleInABrowser, EngineerPlansViewerIsRefusedOperatorCutsEverySheet) {
   Laminad daemon(cell.config("", fmt::format("listen = \"127.0.0.1:{}\"\nstatic_dir = \"{}\"\n{}", port, LAMINA_WEB_BUILD, users)),
                  cell.dir.file(""));
   RpcClient c = connect(cell.socket());  // waits for the daemon's socket, so the console is up too
+  // The rack the engineer plans against: the machine's default sheet, with the slot the
+  // operator's prompt must name.
+  std::filesystem::create_directories(cell.dir.file("parts"));
+  const std::string rack = cell.dir.file("parts/rack.toml");
+  std::ofstream(rack) << "[[sheet]]\nthickness_mm = 5\nwidth_mm = 1250\nlength_mm = 2500\nmaterial = \"aluminium 6061-T6\"\n"
+                         "slot = \"B2 top\"\n";
   const std::string shots = std::string(LAMINA_SHOTS_DIR);
   const auto [out, status] = run_browser({
       fmt::format("LAMINA_URL=http://127.0.0.1:{}", port),
       fmt::format("LAMINA_MODEL={}/knob.stl", LAMINA_EXAMPLES_DIR),
+      fmt::format("LAMINA_STOCK_FILE={}", rack),
       fmt::format("LAMINA_SHOTS={}", shots),
       R"(LAMINA_USERS='{"engineer":["eng","eng-pass"],"operator":["ana","ana-pass"],"viewer":["vic","vic-pass"]}')",
   });

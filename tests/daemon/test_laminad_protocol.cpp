@@ -9,7 +9,10 @@
 #include <sys/un.h>
 
 #include <atomic>
+#include <algorithm>
+#include <chrono>
 #include <fstream>
+#include <thread>
 
 #include "daemon_fixture.hpp"
 
@@ -40,6 +43,43 @@ std::string raw_exchange(const std::string& socket, const std::string& bytes) {
 int error_code(const std::string& reply) {
   const Json j = Json::parse(reply);
   return j.at("error").at("code").get<int>();
+}
+
+// What laminad warns about reaches the people at the cell (the console's Warnings): every
+// logger's warnings, its own at start-up and the RPC server's, in order, and only the new ones
+// for a client that says what it has seen.
+TEST(LaminadProtocol, TheDaemonsWarningsAreThereForTheConsole) {
+  Cell cell;
+  std::string config = cell.config();
+  const std::string roots = "roots = [\"";
+  ASSERT_NE(config.find(roots), std::string::npos) << config;
+  config.replace(config.find(roots), roots.size(), roots + cell.dir.file("no-such-folder") + "\", \"");
+  Laminad daemon(config, cell.dir.file(""));
+  RpcClient c = connect(cell.socket());
+  EXPECT_EQ(error_code(raw_exchange(cell.socket(), std::string(2 << 20, 'x') + "\n")), -32600);
+
+  Json all;
+  for (int i = 0; i < 100 && (all.empty() || all["warnings"].size() < 2); ++i) {  // the RPC's is logged as it closes
+    all = call_ok(c, "server.warnings");
+    if (all["warnings"].size() < 2) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  ASSERT_GE(all["warnings"].size(), 2u) << all.dump(1) << daemon.log();
+  const Json& first = all["warnings"][0];
+  EXPECT_EQ(first["source"], "laminad");
+  EXPECT_EQ(first["level"], "warning");
+  EXPECT_NE(first["message"].get<std::string>().find("no-such-folder is not a folder"), std::string::npos) << first;
+  const auto rpc = std::find_if(all["warnings"].begin(), all["warnings"].end(), [](const Json& w) { return w["source"] == "rpc"; });
+  ASSERT_NE(rpc, all["warnings"].end()) << all.dump(1);
+  EXPECT_NE((*rpc)["message"].get<std::string>().find("over the limit"), std::string::npos) << *rpc;
+  EXPECT_GT((*rpc)["seq"].get<std::uint64_t>(), first["seq"].get<std::uint64_t>());
+  EXPECT_EQ(all["last"], all["warnings"].back()["seq"]);
+
+  const Json none = call_ok(c, "server.warnings", {{"since", all["last"]}});
+  EXPECT_TRUE(none["warnings"].empty()) << none;
+  EXPECT_EQ(none["last"], all["last"]);
+  auto negative = c.call("server.warnings", {{"since", -1}});
+  ASSERT_FALSE(negative);
+  EXPECT_EQ(negative.error().code, -32602);
 }
 
 TEST(LaminadProtocol, EveryBadRequestGetsItsErrorAndTheDaemonKeepsServing) {

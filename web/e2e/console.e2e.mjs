@@ -3,6 +3,7 @@
 // (tests/console/test_console.cpp), which passes everything in the environment:
 //   LAMINA_URL        http://127.0.0.1:PORT
 //   LAMINA_MODEL      the STL to upload
+//   LAMINA_STOCK_FILE the rack's file (on the cell PC, within laminad's roots); its sheet's slot is "B2 top"
 //   LAMINA_SHOTS      folder for the screenshots (test artefacts)
 //   LAMINA_USERS      JSON: {"engineer": [name, password], "operator": […], "viewer": […]}
 // Prints one JSON line per finding ("step") and a last line {"ok": true, metrics…}; exits 1 on
@@ -14,6 +15,7 @@ import { join } from "node:path";
 
 const url = process.env.LAMINA_URL;
 const model = process.env.LAMINA_MODEL;
+const stockFile = process.env.LAMINA_STOCK_FILE;
 const shots = process.env.LAMINA_SHOTS;
 const users = JSON.parse(process.env.LAMINA_USERS ?? "{}");
 const limit = (s) => s * 1000;
@@ -70,10 +72,10 @@ async function waitJobState(page, wanted, seconds) {
   return jobState(page);
 }
 
-// How many distinct colours the 3D view drew (a blank canvas has one).
-async function canvasColours(page) {
-  return page.evaluate(() => {
-    const gl = document.querySelector(".stack3d canvas");
+// How many distinct colours a 3D view drew (a blank canvas has one).
+async function canvasColours(page, selector = ".stack3d canvas") {
+  return page.evaluate((selector) => {
+    const gl = document.querySelector(selector);
     if (!gl) return 0;
     const copy = document.createElement("canvas");
     copy.width = gl.width;
@@ -84,7 +86,33 @@ async function canvasColours(page) {
     const seen = new Set();
     for (let i = 0; i < data.length; i += 4 * 37) seen.add((data[i] << 16) | (data[i + 1] << 8) | data[i + 2]);
     return seen.size;
-  });
+  }, selector);
+}
+
+// The first sheet's program in 3D: drawn, with tool-axis lines on its 5-axis moves, and every
+// cut's tip where the jet meets the sheet (its top face, inside it). A pivot program read as if
+// it carried the tip would put the tilted cuts' tips up to 75 mm below the top face.
+async function toolpathIn3d(page, jobId) {
+  await page.click("article.sheet[data-sheet='1'] .toolpath-open");
+  await page.waitForSelector(".toolpath3d[data-moves]", { timeout: limit(20) });
+  const view = await page.$eval(".toolpath3d", (el) => ({ ...el.dataset }));
+  const report = await page.evaluate(async (id) => (await fetch(`/api/jobs/${id}/report.json`)).json(), jobId);
+  const sheet = report.sheets[0];
+  say("toolpath", { moves: +view.moves, cuts: +view.cuts, tilted: +view.tilted, axis_lines: +view.axisLines, bounds: view.cutBounds });
+  check(+view.tilted > 0 && +view.axisLines > 0, `the 5-axis moves carry tool-axis lines (${view.axisLines} drawn for ${view.tilted} tilted moves)`);
+  check(+view.arcs === 0, "the program has no arcs the view would draw as chords");
+  const { min, max } = JSON.parse(view.cutBounds);
+  const eps = 0.01;
+  check(Math.abs(min[2]) < eps && Math.abs(max[2]) < eps, `every cut's tip is on the sheet's top face (z ${min[2].toFixed(4)} … ${max[2].toFixed(4)} mm)`);
+  check(min[0] >= 0 && min[1] >= 0 && max[0] <= sheet.length_mm && max[1] <= sheet.width_mm,
+    `every cut's tip is on the ${sheet.length_mm} x ${sheet.width_mm} mm sheet (x ${min[0].toFixed(1)} … ${max[0].toFixed(1)}, y ${min[1].toFixed(1)} … ${max[1].toFixed(1)})`);
+  let colours = 0;
+  for (let i = 0; i < 100 && colours < 4; ++i) {
+    await page.waitForTimeout(100);
+    colours = await canvasColours(page, ".toolpath3d canvas");
+  }
+  check(colours >= 4, `the 3D toolpath is drawn (${colours} colours sampled)`);
+  await page.locator(".toolpath3d").screenshot({ path: join(shots, "toolpath-3d.png") });
 }
 
 async function refusals(browser, jobId) {
@@ -137,7 +165,7 @@ async function engineerSubmits(browser, metrics) {
   await page.screenshot({ path: join(shots, "machine.png"), fullPage: true });
   await page.click("nav a[data-view=queue]");
   await page.setInputFiles("input[name=model]", model);
-  await page.fill("input[name=stock]", "5");
+  await page.fill("input[name=stock_file]", stockFile);
   await page.click("#submit-form button[type=submit]");
   await page.waitForURL(/#\/job\/j-/, { timeout: limit(30) });
   const jobId = page.url().split("/").pop();
@@ -168,6 +196,9 @@ async function engineerSubmits(browser, metrics) {
   check(colours >= 10, `the 3D view drew the stack (${colours} colours sampled)`);
   await page.waitForFunction(() => [...document.querySelectorAll("svg.sheet-drawing")].some((s) => s.getBoundingClientRect().width > 100 && s.querySelector("#sheet")), null, { timeout: limit(20) });
   check(true, "a sheet drawing is shown");
+  const sheetTitle = await page.$eval("article.sheet[data-sheet='1'] h3", (el) => el.textContent);
+  check(sheetTitle.includes("rack slot B2 top"), `the sheet names its rack slot: "${sheetTitle}"`);
+  await toolpathIn3d(page, jobId);
   await page.locator(".stack3d").screenshot({ path: join(shots, "stack-3d.png") });
   await page.screenshot({ path: join(shots, "job.png"), fullPage: true });
   await foreignOrigin(context);
@@ -197,7 +228,11 @@ async function operatorCuts(browser, jobId, metrics) {
     const state = await waitJobState(page, ["waiting sheet", "completed", "failed", "cancelled", "paused"], 300);
     if (state !== "waiting sheet") break;
     await page.waitForSelector("#prompt button", { timeout: limit(10) });
-    if (sheets === 0) await page.screenshot({ path: join(shots, "operator-prompt.png"), fullPage: true });
+    if (sheets === 0) {
+      const slot = await page.$eval("#prompt-slot", (el) => el.textContent).catch(() => "(no slot shown)");
+      check(slot.includes("B2 top"), `the operator's prompt says where the sheet lies: "${slot}"`);
+      await page.screenshot({ path: join(shots, "operator-prompt.png"), fullPage: true });
+    }
     await page.click("#prompt button");
     ++sheets;
     await waitJobState(page, ["cutting"], 60);
@@ -217,6 +252,11 @@ async function operatorCuts(browser, jobId, metrics) {
       say("held and resumed once");
       await page.goto(`${url}/#/machine`);
       await page.waitForSelector(".lamps", { timeout: limit(10) });
+      // The daemon's own warnings: the wrong password of refusals() above was logged, and shown.
+      const warned = await page.waitForFunction(() => /failed login as/.test(document.getElementById("daemon-warnings")?.textContent ?? ""), null, {
+        timeout: limit(10),
+      }).then(() => true, () => false);
+      check(warned, "the machine view lists the daemon's warnings (the failed login)");
       await page.screenshot({ path: join(shots, "machine-cutting.png"), fullPage: true });
       await page.goto(`${url}/#/job/${jobId}`);
       await page.waitForSelector("#job-state", { timeout: limit(20) });

@@ -2,8 +2,10 @@
 // (with the head drawn on the one that cuts), and its event log.
 import { clear, duration, fmt, h, notify } from "./dom";
 import type { Rpc } from "./rpc";
+import { type Head, toolAxis, toolTip } from "./kinematics";
 import { SheetView } from "./sheet_view";
 import { StackView } from "./stack_view";
+import { ToolpathView } from "./toolpath_view";
 import type { Job, JobEvent, MachineStatus } from "./types";
 import { progressOf } from "./queue_view";
 
@@ -13,13 +15,16 @@ interface Report {
   warnings: string[];
   deviation: Record<string, { volume_pct: number; max_mm: number }>;
   settings: { strategy: string; tolerance_mm: number };
-  sheets: { index: number; thickness_mm: number; width_mm: number; length_mm: number; material: string; estimated_time_s: number; parts: { layer: number }[] }[];
+  cam?: { rtcp: boolean; head?: Omit<Head, "rtcp"> };
+  sheets: { index: number; thickness_mm: number; width_mm: number; length_mm: number; material: string; slot?: string; estimated_time_s: number; parts: { layer: number }[] }[];
 }
 
 export class JobView {
   private report: Report | null = null;
   private stack: StackView | null = null;
   private sheets = new Map<number, SheetView>();
+  // One 3D toolpath at a time: a browser holds few WebGL contexts, and a job may have many sheets.
+  private toolpath: { sheet: number; view: ToolpathView } | null = null;
   private prompt = h("section", { class: "prompt", id: "prompt" });
   private head = h("section", { class: "job-head" });
   private events = h("section", { class: "events" });
@@ -31,6 +36,7 @@ export class JobView {
 
   dispose(): void {
     this.stack?.dispose();
+    this.toolpath?.view.dispose();
   }
 
   async update(job: Job): Promise<void> {
@@ -40,11 +46,24 @@ export class JobView {
     void this.loadEvents();
   }
 
+  // The head drawn where the jet is: a pivot program's X Y are the pivot's, up to pivot·sin A
+  // (130 mm at 60°) away from the tip.
   machine(status: MachineStatus): void {
     const p = status.position;
     const cutting = status.job === this.jobId && p !== undefined && ["cutting", "paused"].includes(status.job_state ?? "");
-    for (const [index, sheet] of this.sheets)
-      sheet.showHead(cutting && status.sheet === index ? p!.x_mm : null, cutting && status.sheet === index ? p!.y_mm : null);
+    const head = this.machineHead();
+    let tip: [number, number, number] | null = null;
+    if (cutting && head) tip = toolTip(p!.x_mm, p!.y_mm, p!.z_mm, toolAxis(p!.a_deg, p!.c_deg, head), head);
+    for (const [index, sheet] of this.sheets) sheet.showHead(tip && status.sheet === index ? tip[0] : null, tip && status.sheet === index ? tip[1] : null);
+    if (this.toolpath) this.toolpath.view.showHead(cutting && status.sheet === this.toolpath.sheet ? p! : null);
+  }
+
+  // The head of the plan's report; null for a plan written before reports carried it.
+  private machineHead(): Head | null {
+    const cam = this.report?.cam;
+    if (!cam) return null;
+    if (cam.head) return { ...cam.head, rtcp: cam.rtcp };
+    return cam.rtcp ? { pivot_mm: 0, a_sign: 1, c_sign: 1, c_offset_deg: 0, rtcp: true } : null;
   }
 
   private artefact(name: string): string {
@@ -74,6 +93,7 @@ export class JobView {
         this.prompt,
         h("h2", {}, `Load sheet ${sheet.index} of ${job.sheets.length}`),
         h("p", { class: "large" }, `${fmt(sheet.thickness_mm, 1)} mm ${sheet.material} ${size}`),
+        planned?.slot ? h("p", { class: "large slot", id: "prompt-slot" }, `from rack slot ${planned.slot}`) : null,
         h("div", { class: "prompt-drawing" }, new SheetView(this.artefact(`sheet-${sheet.index}.svg`), `sheet ${sheet.index}`).element),
         act("job.confirm_sheet", { job: job.id, sheet: sheet.index }, `Sheet ${sheet.index} is loaded: cut it`),
       );
@@ -120,13 +140,38 @@ export class JobView {
   private sheetPanel(s: Report["sheets"][number]): HTMLElement {
     const view = new SheetView(this.artefact(`sheet-${s.index}.svg`), `sheet ${s.index}`);
     this.sheets.set(s.index, view);
+    const place = h("div", { class: "toolpath-place" });
+    const head = this.machineHead();
+    const open = h("button", { class: "toolpath-open", onclick: () => this.openToolpath(s, place) }, "Toolpath in 3D");
+    if (!head) {
+      open.setAttribute("disabled", "");
+      open.title = "planned before reports carried the head: plan it again to see its toolpath";
+    }
+    const slot = s.slot ? `, rack slot ${s.slot}` : "";
     return h(
       "article",
       { class: "sheet", "data-sheet": String(s.index) },
-      h("h3", {}, `Sheet ${s.index}: ${fmt(s.thickness_mm, 1)} mm ${s.material}, ${fmt(s.length_mm, 0)} × ${fmt(s.width_mm, 0)} mm, ${s.parts.length} parts, about ${duration(s.estimated_time_s)}`),
+      h("h3", {}, `Sheet ${s.index}: ${fmt(s.thickness_mm, 1)} mm ${s.material}, ${fmt(s.length_mm, 0)} × ${fmt(s.width_mm, 0)} mm${slot}, ${s.parts.length} parts, about ${duration(s.estimated_time_s)}`),
       view.element,
-      h("a", { href: this.artefact(`sheet-${s.index}.nc`), download: `sheet-${s.index}.nc` }, "program"),
+      h("p", {}, open, " ", h("a", { href: this.artefact(`sheet-${s.index}.nc`), download: `sheet-${s.index}.nc` }, "program")),
+      place,
     );
+  }
+
+  private openToolpath(s: Report["sheets"][number], place: HTMLElement): void {
+    const head = this.machineHead();
+    if (!head) return;
+    if (this.toolpath) {
+      this.toolpath.view.dispose();
+      this.toolpath.view.element.remove();
+      if (this.toolpath.sheet === s.index) {
+        this.toolpath = null; // the button shows and hides
+        return;
+      }
+    }
+    const view = new ToolpathView(this.artefact(`sheet-${s.index}.nc`), head, s);
+    this.toolpath = { sheet: s.index, view };
+    place.append(view.element);
   }
 
   private async loadEvents(): Promise<void> {

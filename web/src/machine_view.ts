@@ -1,7 +1,7 @@
 // The machine and the cell, for a touchscreen at the machine: state, position, feed, program
 // line, buffer, link; e-stop, door, pump, pressure, abrasive, jet, PLC — large and coloured.
 import { clear, fmt, h } from "./dom";
-import type { MachineStatus } from "./types";
+import type { DaemonWarning, MachineStatus } from "./types";
 
 type Tone = "ok" | "warn" | "bad" | "unknown";
 
@@ -14,7 +14,20 @@ function flag(v: boolean | null | undefined, good: string, bad: string, badTone:
   return v ? [good, "ok"] : [bad, badTone];
 }
 
-export function renderMachine(view: HTMLElement, s: MachineStatus | null): void {
+// The daemon's warnings, newest first: a PLC that went away, a client refused, a failed login.
+function warningList(warnings: DaemonWarning[]): HTMLElement {
+  const shown = warnings.slice(-50).reverse();
+  return h(
+    "section",
+    { class: "daemon-warnings" },
+    h("h2", {}, "Daemon warnings"),
+    shown.length
+      ? h("ol", { id: "daemon-warnings", class: "event-log" }, ...shown.map((w) => h("li", { class: w.level === "warning" ? "warn-text" : "form-error" }, `${new Date(w.t_unix_ms).toLocaleTimeString()} ${w.source}: ${w.message}`)))
+      : h("p", { id: "daemon-warnings" }, "None since laminad started."),
+  );
+}
+
+export function renderMachine(view: HTMLElement, s: MachineStatus | null, warnings: DaemonWarning[] = []): void {
   if (!s) return clear(view, h("p", {}, "Waiting for the machine's status…"));
   const p = s.position;
   const c = s.cell;
@@ -58,5 +71,6 @@ export function renderMachine(view: HTMLElement, s: MachineStatus | null): void 
       h("tr", {}, h("th", {}, "Planner blocks free"), h("td", {}, s.planner_blocks_free ?? "–")),
       h("tr", {}, h("th", {}, "Link"), h("td", {}, s.link ?? "–")),
     ),
+    warningList(warnings),
   );
 }

@@ -6,12 +6,14 @@ import { renderMachine } from "./machine_view";
 import { renderQueue } from "./queue_view";
 import { Rpc } from "./rpc";
 import { currentSession, logout, showLogin } from "./session";
-import type { Job, MachineStatus, Session } from "./types";
+import type { DaemonWarning, Job, MachineStatus, Session } from "./types";
 
 const view = document.getElementById("view")!;
 const rpc = new Rpc();
 const jobs = new Map<string, Job>();
 let machine: MachineStatus | null = null;
+let warnings: DaemonWarning[] = [];
+let lastWarning = 0;
 let session: Session;
 let jobView: JobView | null = null;
 
@@ -36,7 +38,19 @@ function route(): void {
     renderQueue(view, rpc, jobs, can("engineer"), can("engineer"));
   } else {
     view.dataset.mounted = "machine";
-    renderMachine(view, machine);
+    renderMachine(view, machine, warnings);
+  }
+}
+
+// The daemon's warnings: what is new since the last answer, every few seconds (they are rare;
+// the machine's status is what must be live).
+const kWarningsEvery_ms = 3000;
+async function pollWarnings(): Promise<void> {
+  const r = await rpc.call<{ warnings: DaemonWarning[]; last: number }>("server.warnings", { since: lastWarning }).catch(() => null);
+  if (r && r.warnings.length) {
+    warnings = [...warnings, ...r.warnings].slice(-200);
+    lastWarning = r.last;
+    if (view.dataset.mounted === "machine") renderMachine(view, machine, warnings);
   }
 }
 
@@ -73,12 +87,13 @@ async function start(): Promise<void> {
     const pill = document.getElementById("link-state")!;
     pill.textContent = up ? "connected" : `disconnected: ${why}`;
     pill.className = `pill ${up ? "ok" : "bad"}`;
+    if (up) void pollWarnings();
     if (up) rpc.call<Job[]>("job.list").then((list) => { for (const j of list) jobs.set(j.id, { ...jobs.get(j.id), ...j } as Job); route(); }).catch(() => undefined);
   });
   rpc.on("notify_machine_status", (status: MachineStatus) => {
     machine = status;
     updateMotionBar();
-    if (view.dataset.mounted === "machine") renderMachine(view, machine);
+    if (view.dataset.mounted === "machine") renderMachine(view, machine, warnings);
     jobView?.machine(status);
   });
   rpc.on("notify_job_progress", (job: Job) => {
@@ -90,6 +105,7 @@ async function start(): Promise<void> {
   if (!location.hash) location.hash = "#/machine";
   route();
   rpc.connect();
+  setInterval(() => void pollWarnings(), kWarningsEvery_ms);
 }
 
 start().catch((e) => clear(view, h("p", { class: "form-error" }, `The console could not start: ${(e as Error).message}`)));

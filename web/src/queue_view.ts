@@ -31,6 +31,7 @@ function settingsForm(): { form: HTMLFormElement; read: () => Record<string, unk
     h("h2", {}, "Submit a part"),
     h("label", {}, "Model (STL, OBJ, 3MF) ", h("input", { name: "model", type: "file", accept: ".stl,.obj,.3mf", required: true })),
     field("stock", "Stock thicknesses (mm)", { placeholder: "1,2.5,5" }),
+    field("stock_file", "or the rack's file on the cell PC", { placeholder: "/srv/lamina/rack.toml" }),
     field("material", "Material", { placeholder: "as the rack says" }),
     field("tolerance_mm", "Tolerance (mm)", { type: "number", step: "0.01", min: "0" }),
     field("tilt_max_deg", "Largest tilt (°)", { type: "number", step: "1", min: "0", max: "89" }),

@@ -86,3 +86,12 @@ export interface Session {
   logged_in: boolean;
   users_configured: boolean;
 }
+
+// server.warnings: what laminad warned about, oldest first.
+export interface DaemonWarning {
+  seq: number;
+  t_unix_ms: number;
+  level: "warning" | "error" | "critical";
+  source: string;
+  message: string;
+}

@@ -230,6 +230,7 @@ NestedSheet nested_sheet(std::span<const Part> parts, const cam_detail::PackedSh
   ns.width_mm = s.width_mm;
   ns.length_mm = s.length_mm;
   ns.material = s.material;
+  ns.slot = s.slot;
   for (const Placement& pl : packed.placements) tree.emit(pl, ns.placements);
   double area = 0.0;
   for (const Placement& pl : ns.placements) area += parts[pl.part].area_mm2;

@@ -20,7 +20,8 @@ ReportSettings settings_report(const PlanJobRequest& q) {
   for (const SheetStock& sheet : s.stock.sheets)
     r.stock.push_back({sheet.thickness_mm, given(sheet.width_mm), given(sheet.length_mm),
                        sheet.count > 0 ? std::optional<std::int64_t>(sheet.count) : std::nullopt,
-                       sheet.material.empty() ? std::nullopt : std::optional(sheet.material)});
+                       sheet.material.empty() ? std::nullopt : std::optional(sheet.material),
+                       sheet.slot.empty() ? std::nullopt : std::optional(sheet.slot)});
   r.stock_source = s.stock_source;
   r.thicknesses_mm = s.thicknesses_mm;
   r.bond_mm = s.bond_mm;
@@ -87,6 +88,7 @@ ReportCam cam_report(const CamSettings& s, const CamResult& r) {
   c.fill_holes = m.nest.fill_holes;
   c.post = post_dialect_name(m.post.dialect);
   c.rtcp = m.head.rtcp;
+  c.head = ReportHead{m.head.pivot_mm, m.head.a_sign, m.head.c_sign, m.head.c_offset_rad / kDeg};
   c.feed_model = feed_model_name(m.cutting.feed.model);
   c.quality = m.cutting.feed.quality;
   c.kerf_mm = m.cutting.kerf_mm;
@@ -120,6 +122,7 @@ ReportSheet sheet_report(const SheetOutput& s, const std::vector<Part>& parts) {
   r.width_mm = s.sheet.width_mm;
   r.length_mm = s.sheet.length_mm;
   r.material = s.material;
+  if (!s.sheet.slot.empty()) r.slot = s.sheet.slot;
   r.program = s.program_name;
   r.svg = s.svg_name;
   r.estimated_time_s = t.total_s;

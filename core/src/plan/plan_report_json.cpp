@@ -39,7 +39,8 @@ struct Fields<ReportStockSheet> {
   static constexpr auto all =
       std::tuple{Field{"thickness_mm", &ReportStockSheet::thickness_mm}, Field{"width_mm", &ReportStockSheet::width_mm},
                  Field{"length_mm", &ReportStockSheet::length_mm}, Field{"count", &ReportStockSheet::count},
-                 Field{"material", &ReportStockSheet::material}};
+                 Field{"material", &ReportStockSheet::material}, Field{"slot", &ReportStockSheet::slot}};
+  static constexpr bool omit_empty(std::string_view key) { return key == "slot"; }
 };
 template <>
 struct Fields<ReportSettings> {
@@ -116,17 +117,25 @@ struct Fields<ReportCamTiming> {
                                          Field{"svg", &S::svg}};
 };
 template <>
+struct Fields<ReportHead> {
+  using S = ReportHead;
+  static constexpr auto all = std::tuple{Field{"pivot_mm", &S::pivot_mm}, Field{"a_sign", &S::a_sign},
+                                         Field{"c_sign", &S::c_sign}, Field{"c_offset_deg", &S::c_offset_deg}};
+};
+template <>
 struct Fields<ReportCam> {
   using S = ReportCam;
   static constexpr auto all = std::tuple{
       Field{"machine_file", &S::machine_file}, Field{"materials_file", &S::materials_file}, Field{"nest", &S::nest},
       Field{"spacing_mm", &S::spacing_mm},     Field{"margin_mm", &S::margin_mm},           Field{"fill_holes", &S::fill_holes},
-      Field{"post", &S::post},                 Field{"rtcp", &S::rtcp},                     Field{"feed_model", &S::feed_model},
+      Field{"post", &S::post},                 Field{"rtcp", &S::rtcp},                     Field{"head", &S::head},
+      Field{"feed_model", &S::feed_model},
       Field{"quality", &S::quality},           Field{"kerf_mm", &S::kerf_mm},               Field{"lead_in_mm", &S::lead_in_mm},
       Field{"lead_out_mm", &S::lead_out_mm},   Field{"pierce_dwell_s", &S::pierce_dwell_s}, Field{"microjoints", &S::microjoints},
       Field{"microjoint_width_mm", &S::microjoint_width_mm}, Field{"dowels", &S::dowels},
       Field{"dowel_diameter_mm", &S::dowel_diameter_mm},     Field{"parts", &S::parts},
       Field{"timing_s", &S::timing_s}};
+  static constexpr bool omit_empty(std::string_view key) { return key == "head"; }
 };
 template <>
 struct Fields<ReportPart> {
@@ -157,6 +166,7 @@ struct Fields<ReportSheet> {
       Field{"width_mm", &S::width_mm},
       Field{"length_mm", &S::length_mm},
       Field{"material", &S::material},
+      Field{"slot", &S::slot},
       Field{"program", &S::program},
       Field{"svg", &S::svg},
       Field{"estimated_time_s", &S::estimated_time_s},
@@ -173,6 +183,7 @@ struct Fields<ReportSheet> {
       Field{"parts", &S::parts},
       Field{"setup_lines", &S::setup_lines},
       Field{"contour_lines", &S::contour_lines}};
+  static constexpr bool omit_empty(std::string_view key) { return key == "slot"; }
 };
 template <>
 struct Fields<PlanReport> {

@@ -215,7 +215,7 @@ inline Summary check_nest(std::span<const Part> parts, const Stock& stock, const
 
 inline Stock one_sheet_kind(double thickness, double length, double width, int count = 0) {
   Stock s;
-  s.sheets.push_back({thickness, width, length, count, "aluminium"});
+  s.sheets.push_back({thickness, width, length, count, "aluminium", ""});
   return s;
 }
 

@@ -26,9 +26,9 @@ TEST_P(NestDriver, ThinSheetsFirstWhateverThePartOrder) {
   for (int i = 0; i < 3; ++i) parts.push_back(make_part(rect(150, 150), 1.0, 1, i + 1));
   for (int i = 0; i < 3; ++i) parts.push_back(make_part(rect(150, 150), 2.5, 3, i + 1));
   Stock stock;
-  stock.sheets.push_back({5.0, 200, 200, 0, "al"});
-  stock.sheets.push_back({2.5, 200, 200, 0, "al"});
-  stock.sheets.push_back({1.0, 200, 200, 0, "al"});
+  stock.sheets.push_back({5.0, 200, 200, 0, "al", ""});
+  stock.sheets.push_back({2.5, 200, 200, 0, "al", ""});
+  stock.sheets.push_back({1.0, 200, 200, 0, "al", ""});
   const NestParams params = params_for(GetParam());
   auto nest = nest_parts(parts, stock, params);
   ASSERT_TRUE(nest) << nest.error().message;
@@ -41,9 +41,9 @@ TEST_P(NestDriver, StockEntriesInRackOrderUpToTheirCounts) {
   std::vector<Part> parts;
   for (int i = 0; i < 7; ++i) parts.push_back(make_part(rect(150, 150), 5.0, 1, i + 1));
   Stock stock;
-  stock.sheets.push_back({5.0, 200, 200, 2, "big"});
-  stock.sheets.push_back({1.0, 200, 200, 9, "thin"});
-  stock.sheets.push_back({5.0, 180, 180, 0, "offcut"});
+  stock.sheets.push_back({5.0, 200, 200, 2, "big", ""});
+  stock.sheets.push_back({1.0, 200, 200, 9, "thin", ""});
+  stock.sheets.push_back({5.0, 180, 180, 0, "offcut", ""});
   const NestParams params = params_for(GetParam());
   auto nest = nest_parts(parts, stock, params);
   ASSERT_TRUE(nest) << nest.error().message;
@@ -58,8 +58,8 @@ TEST_P(NestDriver, StockEntriesInRackOrderUpToTheirCounts) {
 TEST_P(NestDriver, PartsTooBigForTheFirstEntryGoToALaterOne) {
   std::vector<Part> parts{make_part(rect(50, 50), 3.0, 1, 1), make_part(rect(300, 100), 3.0, 1, 2)};
   Stock stock;
-  stock.sheets.push_back({3.0, 100, 100, 5, "small"});
-  stock.sheets.push_back({3.0, 200, 400, 5, "long"});
+  stock.sheets.push_back({3.0, 100, 100, 5, "small", ""});
+  stock.sheets.push_back({3.0, 200, 400, 5, "long", ""});
   const NestParams params = params_for(GetParam());
   auto nest = nest_parts(parts, stock, params);
   ASSERT_TRUE(nest) << nest.error().message;
@@ -94,8 +94,8 @@ TEST_P(NestDriver, SheetSizeUnknown) {
 TEST_P(NestDriver, PartBiggerThanEverySheet) {
   std::vector<Part> parts{make_part(rect(10, 10), 2.0, 3, 1), make_part(rect(500, 120), 2.0, 3, 2)};
   Stock stock;
-  stock.sheets.push_back({2.0, 200, 400, 0, ""});  // usable 380 x 180 (margin 10)
-  stock.sheets.push_back({2.0, 100, 450, 0, ""});  // usable 430 x 80
+  stock.sheets.push_back({2.0, 200, 400, 0, "", ""});  // usable 380 x 180 (margin 10)
+  stock.sheets.push_back({2.0, 100, 450, 0, "", ""});  // usable 430 x 80
   NestParams params = params_for(GetParam());
   params.margin_mm = 10.0;
   auto nest = nest_parts(parts, stock, params);
@@ -111,8 +111,8 @@ TEST_P(NestDriver, NotEnoughSheets) {
   std::vector<Part> parts;
   for (int i = 0; i < 5; ++i) parts.push_back(make_part(rect(150, 150), 10.0, 7, i + 1));
   Stock stock;
-  stock.sheets.push_back({10.0, 200, 200, 1, ""});
-  stock.sheets.push_back({10.0, 190, 190, 2, ""});
+  stock.sheets.push_back({10.0, 200, 200, 1, "", ""});
+  stock.sheets.push_back({10.0, 190, 190, 2, "", ""});
   auto nest = nest_parts(parts, stock, params_for(GetParam()));
   ASSERT_FALSE(nest);
   EXPECT_EQ(nest.error().code, ErrorCode::stock_exhausted);
@@ -132,8 +132,8 @@ TEST_P(NestDriver, ShortagesCountTheLayersPlacedWhole) {
   parts.push_back(make_part(rect(20, 20), 1.0, 9, 1));  // a thickness with enough sheets
   parts.back().layer_slot = 9;
   Stock stock;
-  stock.sheets.push_back({10.0, 200, 200, 3, ""});
-  stock.sheets.push_back({1.0, 100, 100, 1, ""});
+  stock.sheets.push_back({10.0, 200, 200, 3, "", ""});
+  stock.sheets.push_back({1.0, 100, 100, 1, "", ""});
   std::vector<SheetShortage> shortages;
   auto nest = nest_parts(parts, stock, params_for(GetParam()), &shortages);
   ASSERT_FALSE(nest);

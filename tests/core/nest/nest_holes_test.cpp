@@ -394,8 +394,8 @@ TEST_P(NestHoles, SeededRandomRingsAndSmallParts) {
       parts.push_back(make_part(ring, i % 3 ? 3.0 : 1.5, 20 + i / 10, 1 + i % 10));
     }
     Stock stock;
-    stock.sheets.push_back({3.0, 500, 800, 0, "3 mm"});
-    stock.sheets.push_back({1.5, 500, 800, 0, "1.5 mm"});
+    stock.sheets.push_back({3.0, 500, 800, 0, "3 mm", ""});
+    stock.sheets.push_back({1.5, 500, 800, 0, "1.5 mm", ""});
     const NestParams params = with(GetParam(), true, 5.0, 12.0);
     for (double t : {1.5, 3.0}) {
       std::vector<int> group;

@@ -37,9 +37,9 @@ std::vector<Part> random_parts(int n, unsigned seed, double thickness_a, double 
 
 Stock rack() {
   Stock s;
-  s.sheets.push_back({3.0, 600, 1200, 3, "3 mm"});
-  s.sheets.push_back({1.5, 500, 1000, 0, "1.5 mm"});
-  s.sheets.push_back({3.0, 500, 1000, 0, "3 mm offcut"});
+  s.sheets.push_back({3.0, 600, 1200, 3, "3 mm", ""});
+  s.sheets.push_back({1.5, 500, 1000, 0, "1.5 mm", ""});
+  s.sheets.push_back({3.0, 500, 1000, 0, "3 mm offcut", ""});
   return s;
 }
 

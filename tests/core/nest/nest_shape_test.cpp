@@ -96,8 +96,8 @@ TEST(NestShape, SameResultWithAndWithoutThreads) {
     parts.push_back(make_part(i % 3 == 0 ? triangle(90, 60) : i % 3 == 1 ? ell(70, 80, 20) : circle(30), 1.0 + (i % 2),
                               1 + i % 2, i + 1));
   Stock stock;
-  stock.sheets.push_back({1.0, 300, 500, 0, ""});
-  stock.sheets.push_back({2.0, 300, 500, 0, ""});
+  stock.sheets.push_back({1.0, 300, 500, 0, "", ""});
+  stock.sheets.push_back({2.0, 300, 500, 0, "", ""});
   NestParams a = with(NestMethod::shape);
   a.parallel = true;
   NestParams b = a;

@@ -8,6 +8,7 @@
 #include "mesh_soups.hpp"
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <string>
 #include <vector>
@@ -25,7 +26,7 @@ const Mesh& ball() {
 
 PlanJobRequest request(bool with_programs) {
   PlanJobRequest q;
-  q.settings.stock.sheets = {{2.5, 300, 300, 4, ""}, {5.0, 300, 300, 8, ""}};
+  q.settings.stock.sheets = {{2.5, 300, 300, 4, "", ""}, {5.0, 300, 300, 8, "", "B4"}};
   q.settings.stock_source = "test";
   q.settings.thicknesses_mm = {2.5, 5.0};
   q.settings.tolerance_mm = 0.3;
@@ -37,6 +38,9 @@ PlanJobRequest request(bool with_programs) {
     CamSettings cam;
     cam.materials.materials.emplace("aluminium 6061-T6", Material{"aluminium 6061-T6", 2700, 0.0, 213});
     cam.machine.head.rtcp = false;  // the default post is grblHAL's: pivot coordinates and G93
+    cam.machine.head.pivot_mm = 120.0;
+    cam.machine.head.c_sign = -1;
+    cam.machine.head.c_offset_rad = 90.0 * 3.14159265358979 / 180.0;
     cam.parts.kerf_mm = cam.machine.cutting.kerf_mm;
     cam.machine_source = "machine.toml";
     cam.materials_source = "materials.toml";
@@ -82,6 +86,39 @@ TEST(PlanJob, ReportJsonReadsBackToTheSameText) {
   EXPECT_EQ(back->sheets->front().parts.size(), planned().report.sheets->front().parts.size());
 }
 
+// A reader of the programs (the web console's 3D toolpath) needs the head to turn X Y Z A C into
+// the tool tip and axis, and the operator the rack slot each sheet is taken from.
+TEST(PlanJob, TheReportCarriesTheHeadAndEachSheetsRackSlot) {
+  const PlanReport& report = planned().report;
+  ASSERT_TRUE(report.cam && report.cam->head);
+  EXPECT_EQ(report.cam->head->pivot_mm, 120.0);
+  EXPECT_EQ(report.cam->head->a_sign, 1);
+  EXPECT_EQ(report.cam->head->c_sign, -1);
+  EXPECT_NEAR(report.cam->head->c_offset_deg, 90.0, 1e-9);
+  EXPECT_FALSE(report.cam->rtcp);
+  ASSERT_TRUE(report.sheets);
+  std::size_t thick = 0;
+  for (const ReportSheet& s : *report.sheets) {
+    EXPECT_EQ(s.slot, s.thickness_mm == 5.0 ? std::optional<std::string>("B4") : std::nullopt) << s.index;
+    thick += s.thickness_mm == 5.0;
+  }
+  EXPECT_GT(thick, 0u);
+  EXPECT_EQ(report.settings.stock[1].slot, "B4");
+  EXPECT_FALSE(report.settings.stock[0].slot);
+}
+
+// A job planned by 0.7.0 (no head, no slots) is still read when laminad resumes it after an upgrade.
+TEST(PlanJob, AReportWithoutHeadOrSlotsStillReads) {
+  nlohmann::json j = nlohmann::json::parse(plan_report_json(planned().report));
+  j["cam"].erase("head");
+  for (auto& s : j["sheets"]) s.erase("slot");
+  for (auto& s : j["settings"]["stock"]) s.erase("slot");
+  auto back = parse_plan_report(j.dump());
+  ASSERT_TRUE(back) << back.error().message;
+  EXPECT_FALSE(back->cam->head);
+  EXPECT_FALSE(back->sheets->back().slot);
+}
+
 TEST(PlanJob, WithoutProgramsTheReportHasNoSheetsAndReadsBack) {
   auto r = plan_job(ball(), request(false));
   ASSERT_TRUE(r) << r.error().error.message;
@@ -120,7 +157,7 @@ TEST(PlanJob, ProgressNamesEveryPhaseInOrderAndItsStepsGrow) {
 
 TEST(PlanJob, AnErrorSaysInWhichPhase) {
   PlanJobRequest q = request(false);
-  q.settings.stock.sheets = {{100.0, 0, 0, 0, ""}};
+  q.settings.stock.sheets = {{100.0, 0, 0, 0, "", ""}};
   q.settings.thicknesses_mm = {100.0};
   auto r = plan_job(ball(), q);
   ASSERT_FALSE(r);

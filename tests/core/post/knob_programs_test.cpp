@@ -55,7 +55,7 @@ const KnobSheets& knob() {
     EXPECT_TRUE(parts) << parts.error().message;
     out.parts = std::move(*parts);
     lamina::Stock stock;
-    for (double t : {1.0, 2.5, 5.0, 10.0}) stock.sheets.push_back({t, 300.0, 500.0, 0, "aluminium 6061-T6"});
+    for (double t : {1.0, 2.5, 5.0, 10.0}) stock.sheets.push_back({t, 300.0, 500.0, 0, "aluminium 6061-T6", ""});
     lamina::NestParams np;
     np.method = lamina::NestMethod::matrix;
     auto nest = lamina::nest_parts(out.parts, stock, np);

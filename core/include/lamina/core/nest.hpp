@@ -52,6 +52,7 @@ struct NestedSheet {
   double width_mm = 0.0;     // sheet y extent
   double length_mm = 0.0;    // sheet x extent
   std::string material;
+  std::string slot;          // the rack slot of its stock entry; "" = not given
   // In the order the parts are numbered on the sheet. A part inside another's hole comes before
   // its host (children first, then the host, recursively), and the cutting order must keep that:
   // a placement is cut completely before placements[host] (Placement::host).

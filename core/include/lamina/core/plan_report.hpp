@@ -29,6 +29,7 @@ struct ReportStockSheet {  // a sheet (type) of the rack; null: not given
   std::optional<double> width_mm, length_mm;
   std::optional<std::int64_t> count;
   std::optional<std::string> material;
+  std::optional<std::string> slot;  // where it lies on the rack; left out of the file when not given
 };
 
 struct ReportSettings {
@@ -83,12 +84,22 @@ struct ReportCamTiming {  // seconds
   double parts = 0.0, nest = 0.0, toolpath = 0.0, post = 0.0, svg = 0.0;
 };
 
+// The head as the program's coordinates need it (kinematics.hpp), so a reader of sheet-<n>.nc (the
+// web console's 3D toolpath) turns its X Y Z A C into the tool tip and axis without the machine
+// file. Degrees, as the program's A and C are.
+struct ReportHead {
+  double pivot_mm = 0.0;
+  std::int64_t a_sign = 1, c_sign = 1;
+  double c_offset_deg = 0.0;
+};
+
 struct ReportCam {
   std::string machine_file, materials_file, nest;
   double spacing_mm = 0.0, margin_mm = 0.0;
   bool fill_holes = false;
   std::string post;
   bool rtcp = false;
+  std::optional<ReportHead> head;  // absent in reports written before it (0.7.0 and older)
   std::string feed_model;
   std::int64_t quality = 0;
   double kerf_mm = 0.0, lead_in_mm = 0.0, lead_out_mm = 0.0, pierce_dwell_s = 0.0;
@@ -124,6 +135,7 @@ struct ReportSheet {
   std::int64_t index = 0;
   double thickness_mm = 0.0, width_mm = 0.0, length_mm = 0.0;
   std::string material;
+  std::optional<std::string> slot;  // the rack slot of its stock entry, when the stock file names one
   std::string program, svg;  // file names in the plan's folder
   double estimated_time_s = 0.0;
   ReportSheetTime time_s;

@@ -11,6 +11,7 @@ struct SheetStock {
   double length_mm = 0.0;
   int count = 0;           // sheets on the rack; 0 = not given / unlimited for planning
   std::string material;
+  std::string slot;        // where the operator finds it ("R3", "rack 2 shelf B"); "" = not given
 };
 
 struct Stock {
