@@ -134,7 +134,8 @@ TEST(CliPlanRack, EverySheetSaysWhichRackSlotItComesFrom) {
   // No slot given: no key in the report (and reports without one still read: PlanReportJson).
   const auto plain = lamina("plan " + quoted(dir.path / "cone.stl") + " --stock 5 --out " + quoted(dir.path / "plain"));
   ASSERT_EQ(plain.exit_code, 0) << plain.out;
-  for (const json& s : read_report(dir.path / "plain")["sheets"]) EXPECT_FALSE(s.contains("slot")) << s.dump();
+  const json unslotted = read_report(dir.path / "plain");
+  for (const json& s : unslotted["sheets"]) EXPECT_FALSE(s.contains("slot")) << s.dump();
 }
 
 TEST(CliPlanRack, ASlotThatIsNoLabelIsRefusedWithItsLine) {
