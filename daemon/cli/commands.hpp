@@ -10,5 +10,6 @@ void add_plan_command(CLI::App& app, int& exit_code);
 void add_ports_command(CLI::App& app, int& exit_code);
 void add_stream_command(CLI::App& app, int& exit_code);
 void add_client_commands(CLI::App& app, int& exit_code);  // laminad: submit, jobs, status…
+void add_calibrate_command(CLI::App& app, int& exit_code);  // the jet's kerf from test cuts
 
 }  // namespace lamina::cli

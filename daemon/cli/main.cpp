@@ -12,6 +12,7 @@ int main(int argc, char** argv) {
   lamina::cli::add_ports_command(app, exit_code);
   lamina::cli::add_stream_command(app, exit_code);
   lamina::cli::add_client_commands(app, exit_code);
+  lamina::cli::add_calibrate_command(app, exit_code);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -1,0 +1,107 @@
+// lamina calibrate fit MEASUREMENTS.csv --material M: a coupon's measured cuts in, the kerf
+// model's coefficients out (docs/jet.md) — the residuals printed, so a person sees which cut
+// disagrees — into the kerf file, where the material's earlier calibration is replaced.
+#include "commands.hpp"
+#include "kerf_files.hpp"
+#include "machine_config.hpp"
+#include "materials_config.hpp"
+#include "toml_file.hpp"
+
+#include "lamina/core/kerf.hpp"
+
+#include <fmt/format.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+
+namespace lamina::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct FitOptions {
+  std::string measurements, material, kerf_file, materials_file;
+};
+
+int fail(const Error& e) {
+  fmt::print(stderr, "error [{}]: {}\n", error_code_name(e.code), e.message);
+  return 1;
+}
+
+void print_fit(const KerfFit& fit, const std::string& material) {
+  const KerfModel& m = fit.model;
+  fmt::print("kerf of {} from {} cuts:\n", material, fit.residuals.size());
+  fmt::print("  top width    w_t = {:.4f} {:+.4f}·r mm\n", m.top_width_mm, m.top_width_per_ratio_mm);
+  fmt::print("  taper        (w_t - w_b)/h_f = {:.5f}·(r - {:.3f})\n", m.taper_per_ratio, m.taper_free_ratio);
+  fmt::print("  trail-back   {:.4f}·h_f·r^{:.3f} mm\n\n", m.trail_back_factor, m.trail_back_exponent);
+  fmt::print("{:<16} {:>10} {:>10} {:>10}   (measured - model, mm)\n", "cut", "top", "bottom", "trail");
+  for (const KerfResidual& r : fit.residuals)
+    fmt::print("{:<16} {:>+10.4f} {:>+10.4f} {:>+10.4f}\n", r.label, r.top_width_mm, r.bottom_width_mm, r.trail_back_mm);
+  fmt::print("rms: widths {:.4f} mm, trail-back {:.4f} mm\n", fit.rms_width_mm, fit.rms_trail_back_mm);
+}
+
+// The kerf file with this material's calibration replaced; written whole to a temporary file
+// and renamed, so a crash leaves the old file or the new one, never half of one.
+std::expected<void, Error> store(const FitOptions& o, const KerfFit& fit) {
+  KerfCalibrations all;
+  if (fs::exists(o.kerf_file)) {
+    auto text = read_config_file(o.kerf_file, "kerf");
+    if (!text) return std::unexpected(text.error());
+    auto parsed = parse_kerf_toml(*text, o.kerf_file);
+    if (!parsed) return std::unexpected(parsed.error());
+    all = std::move(*parsed);
+  }
+  all[o.material] = {fit.model, static_cast<std::int64_t>(fit.residuals.size()), fit.rms_width_mm, fit.rms_trail_back_mm,
+                     fs::path(o.measurements).filename().string()};
+  const std::string temp = o.kerf_file + ".new";
+  {
+    std::ofstream out(temp, std::ios::trunc);
+    out << kerf_toml(all);
+    out.flush();
+    if (!out) return std::unexpected(Error{ErrorCode::io_error, fmt::format("cannot write {}", temp)});
+  }
+  std::error_code ec;
+  fs::rename(temp, o.kerf_file, ec);
+  if (ec) return std::unexpected(Error{ErrorCode::io_error, fmt::format("cannot replace {}: {}", o.kerf_file, ec.message())});
+  return {};
+}
+
+int run_fit(const FitOptions& o) {
+  // The name `lamina plan` will look the calibration up by: one of the materials file's.
+  auto materials = load_materials(o.materials_file);
+  if (!materials) return fail(materials.error());
+  if (auto known = find_material(*materials, o.material); !known) return fail(known.error());
+  auto text = read_config_file(o.measurements, "measurements");
+  if (!text) return fail(text.error());
+  auto cuts = parse_kerf_measurements(*text, o.measurements);
+  if (!cuts) return fail(cuts.error());
+  auto fit = fit_kerf_model(*cuts);
+  if (!fit) return fail(fit.error());
+  print_fit(*fit, o.material);
+  if (auto stored = store(o, *fit); !stored) return fail(stored.error());
+  fmt::print("wrote the kerf of {} to {}\n", o.material, o.kerf_file);
+  return 0;
+}
+
+}  // namespace
+
+void add_calibrate_command(CLI::App& app, int& exit_code) {
+  auto* calibrate = app.add_subcommand("calibrate", "Calibrate the jet's kerf (taper, trail-back) from test cuts (docs/jet.md)");
+  calibrate->require_subcommand(1);
+  auto o = std::make_shared<FitOptions>();
+  auto* fit = calibrate->add_subcommand("fit", "Fit the kerf model to a coupon's measured cuts and store it for the material");
+  fit->add_option("measurements", o->measurements, "CSV: label,path_mm,feed_ratio,top_width_mm,bottom_width_mm,trail_back_mm")
+      ->required();
+  fit->add_option("--material", o->material, "the material the coupon was cut from (as in the materials file)")->required();
+  fit->add_option("--kerf-file", o->kerf_file, "where calibrations are kept (default: <config>/kerf.toml)");
+  fit->add_option("--materials", o->materials_file, "the materials file the name is from (default: <config>/materials.toml)");
+  fit->callback([o, &exit_code] {
+    if (o->kerf_file.empty()) o->kerf_file = (fs::path(default_config_dir()) / "kerf.toml").string();
+    if (o->materials_file.empty()) o->materials_file = (fs::path(default_config_dir()) / "materials.toml").string();
+    exit_code = run_fit(*o);
+  });
+}
+
+}  // namespace lamina::cli

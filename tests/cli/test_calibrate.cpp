@@ -1,0 +1,132 @@
+// `lamina calibrate fit` (issue 20): a coupon's measurements in, the kerf model out — its
+// coefficients recovered from a coupon measured with a caliper's noise, the residuals printed per
+// cut, stored per material in the kerf file (another material's calibration kept), and every
+// broken measurement file named by line and column, with nothing written.
+#include "cli_runner.hpp"
+#include "kerf_files.hpp"
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <random>
+#include <sstream>
+
+namespace {
+
+using namespace lamina_cli_test;
+using lamina::KerfModel;
+
+struct TempDir {
+  fs::path path;
+  explicit TempDir(const std::string& name) : path(temp_file(name)) {
+    fs::remove_all(path);
+    fs::create_directories(path);
+  }
+  ~TempDir() { fs::remove_all(path); }
+};
+
+const KerfModel kTruth{.top_width_mm = 0.92,
+                       .top_width_per_ratio_mm = -0.05,
+                       .taper_per_ratio = 0.06,
+                       .taper_free_ratio = 0.3,
+                       .trail_back_factor = 0.1,
+                       .trail_back_exponent = 2.2};
+
+// The CSV a person fills in after cutting a coupon (columns in their own order).
+std::string coupon_csv(unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> caliper(0.0, 0.01), gauge(0.0, 0.03);
+  std::ostringstream csv;
+  csv << "# coupon, 10 mm aluminium\nfeed_ratio, label, path_mm, top_width_mm, bottom_width_mm, trail_back_mm\n";
+  for (double path : {6.0, 12.0})
+    for (double r : {0.2, 0.4, 0.6, 0.8, 1.0}) {
+      const auto k = *lamina::kerf_at(kTruth, path, r);
+      csv << r << ", cut-" << path << "-" << r << ", " << path << ", " << k.top_width_mm + caliper(rng) << ", "
+          << k.bottom_width_mm + caliper(rng) << ", " << k.trail_back_mm * (1 + gauge(rng)) << "\r\n";
+    }
+  return csv.str();
+}
+
+TEST(CalibrateFit, RecoversTheKerfAndKeepsOtherMaterials) {
+  TempDir dir("calibrate-fit");
+  std::ofstream(dir.path / "al.csv") << coupon_csv(7);
+  std::ofstream(dir.path / "steel.csv") << coupon_csv(8);
+  const std::string kerf = quoted(dir.path / "kerf.toml");
+  auto r = lamina_cli_test::lamina("calibrate fit " + quoted(dir.path / "al.csv") + " --material 'aluminium 6061-T6' --kerf-file " + kerf);
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_NE(r.out.find("cut-6-0.2"), std::string::npos) << "a residual per cut:\n" << r.out;
+  EXPECT_NE(r.out.find("rms: widths"), std::string::npos) << r.out;
+  r = lamina_cli_test::lamina("calibrate fit " + quoted(dir.path / "steel.csv") + " --material 'mild steel' --kerf-file " + kerf);
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+
+  std::ifstream in(dir.path / "kerf.toml");
+  const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  auto stored = lamina::cli::parse_kerf_toml(text, "kerf.toml");
+  ASSERT_TRUE(stored) << stored.error().message << "\n" << text;
+  ASSERT_EQ(stored->size(), 2u) << text;
+  const auto& al = stored->at("aluminium 6061-T6");
+  EXPECT_EQ(al.cuts, 10);
+  EXPECT_EQ(al.measurements, "al.csv");
+  EXPECT_NEAR(al.model.top_width_mm, 0.92, 0.03);
+  EXPECT_NEAR(al.model.taper_per_ratio, 0.06, 0.006);
+  EXPECT_NEAR(al.model.taper_free_ratio, 0.3, 0.06);
+  EXPECT_NEAR(al.model.trail_back_exponent, 2.2, 0.1);
+  EXPECT_NEAR(al.model.trail_back_factor, 0.1, 0.012);
+  EXPECT_LT(al.rms_width_mm, 0.02);
+  EXPECT_FALSE(fs::exists(dir.path / "kerf.toml.new"));
+
+  // Fitting aluminium again replaces its table and keeps steel's.
+  std::ofstream(dir.path / "al2.csv") << coupon_csv(9);
+  r = lamina_cli_test::lamina("calibrate fit " + quoted(dir.path / "al2.csv") + " --material 'aluminium 6061-T6' --kerf-file " + kerf);
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  std::ifstream again(dir.path / "kerf.toml");
+  stored = lamina::cli::parse_kerf_toml(std::string{std::istreambuf_iterator<char>(again), std::istreambuf_iterator<char>()}, "kerf.toml");
+  ASSERT_TRUE(stored);
+  EXPECT_EQ(stored->size(), 2u);
+  EXPECT_EQ(stored->at("aluminium 6061-T6").measurements, "al2.csv");
+}
+
+TEST(CalibrateFit, ABrokenMeasurementFileIsNamedByLineAndNothingIsWritten) {
+  TempDir dir("calibrate-bad");
+  const std::string header = "label,path_mm,feed_ratio,top_width_mm,bottom_width_mm,trail_back_mm\n";
+  const std::vector<std::pair<std::string, std::string>> cases{
+      {header + "a,10,0.5,0.9,0.85,0.3\nb,10,0.8,0.9,abc,0.5\n", "m.csv:3: bottom_width_mm: 'abc' is not a number"},
+      {header + "a,10,0.5,0.9,0.85\n", "m.csv:2: 5 values; the header has 6 columns"},
+      {"label,path_mm,feed_ratio,top_width_mm,bottom_width_mm\n", "m.csv:1: no column 'trail_back_mm' in the header"},
+      {"label,path,feed_ratio,top_width_mm,bottom_width_mm,trail_back_mm\n", "m.csv:1: unknown column 'path'"},
+      {header, "m.csv: a header and no measurements"},
+      {header + "a,10,0.5,0.9,0.85,0.3\nb,10,0.8,0.9,0.8,0\n", "cut 'b': trail-back 0 mm"},
+      {header + "a,10,0.5,0.9,0.85,0.3\nb,5,0.5,0.9,0.88,0.15\n", "needs cuts at two speeds at least"}};
+  for (const auto& [csv, message] : cases) {
+    std::ofstream(dir.path / "m.csv") << csv;
+    const auto r = lamina_cli_test::lamina("calibrate fit " + quoted(dir.path / "m.csv") + " --material brass --kerf-file " + quoted(dir.path / "kerf.toml"));
+    EXPECT_EQ(r.exit_code, 1) << csv << r.out;
+    EXPECT_NE(r.out.find(message), std::string::npos) << "wanted: " << message << "\n" << r.out;
+    EXPECT_FALSE(fs::exists(dir.path / "kerf.toml")) << csv;
+  }
+  // A name `lamina plan` would never look up.
+  std::ofstream(dir.path / "m.csv") << coupon_csv(1);
+  const auto unknown = lamina_cli_test::lamina("calibrate fit " + quoted(dir.path / "m.csv") + " --material alu --kerf-file " + quoted(dir.path / "kerf.toml"));
+  EXPECT_EQ(unknown.exit_code, 1) << unknown.out;
+  EXPECT_NE(unknown.out.find("alu"), std::string::npos) << unknown.out;
+  EXPECT_NE(unknown.out.find("aluminium 6061-T6"), std::string::npos) << "the known names:\n" << unknown.out;
+  EXPECT_FALSE(fs::exists(dir.path / "kerf.toml"));
+  const auto usage = lamina_cli_test::lamina("calibrate fit " + quoted(dir.path / "m.csv"));
+  EXPECT_EQ(usage.exit_code, 2) << usage.out;
+  EXPECT_NE(usage.out.find("--material"), std::string::npos) << usage.out;
+}
+
+TEST(KerfFile, AHandEditedFileIsCheckedKeyByKey) {
+  const std::string good = lamina::cli::kerf_toml({{"brass", {kTruth, 12, 0.01, 0.02, "b.csv"}}});
+  auto back = lamina::cli::parse_kerf_toml(good, "kerf.toml");
+  ASSERT_TRUE(back) << back.error().message << "\n" << good;
+  EXPECT_NEAR(back->at("brass").model.trail_back_exponent, 2.2, 1e-9);
+  auto typo = lamina::cli::parse_kerf_toml("[[kerf]]\nmaterial = \"a\"\ntaper_ratio = 1\n", "kerf.toml");
+  ASSERT_FALSE(typo);
+  EXPECT_NE(typo.error().message.find("kerf.toml:3: unknown key 'taper_ratio' in [[kerf]]"), std::string::npos) << typo.error().message;
+  auto partial = lamina::cli::parse_kerf_toml("[[kerf]]\nmaterial = \"a\"\ntop_width_mm = 1\n", "kerf.toml");
+  ASSERT_FALSE(partial);
+  EXPECT_NE(partial.error().message.find("lacks some of its 6 coefficients"), std::string::npos) << partial.error().message;
+}
+
+}  // namespace
