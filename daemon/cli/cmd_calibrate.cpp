@@ -7,7 +7,10 @@
 #include "materials_config.hpp"
 #include "toml_file.hpp"
 
+#include "lamina/core/coupon.hpp"
 #include "lamina/core/kerf.hpp"
+#include "lamina/core/post.hpp"
+#include "plan_cam.hpp"
 
 #include <fmt/format.h>
 
@@ -85,6 +88,57 @@ int run_fit(const FitOptions& o) {
   return 0;
 }
 
+struct CouponOptions {
+  CamOptions cam;
+  double thickness_mm = 0.0;
+  std::string out_dir;
+};
+
+std::expected<void, Error> write_file(const fs::path& path, const std::string& text) {
+  std::ofstream out(path, std::ios::trunc);
+  out << text;
+  out.flush();
+  if (!out) return std::unexpected(Error{ErrorCode::io_error, fmt::format("cannot write {}", path.string())});
+  return {};
+}
+
+// The CSV a person fills in: each cut's label, path and feed ratio, the measurements left empty.
+std::string measurement_sheet(const Coupon& coupon, const std::string& material, double thickness_mm) {
+  std::string csv = fmt::format("# calibration coupon: {} mm {}; measure each slot's top and bottom width and its\n"
+                                "# trail-back (mm), fill in the last three columns, then: lamina calibrate fit THIS.csv --material '{}'\n"
+                                "label,path_mm,feed_ratio,top_width_mm,bottom_width_mm,trail_back_mm\n",
+                                thickness_mm, material, material);
+  for (const CouponCut& c : coupon.cuts) csv += fmt::format("{},{:.4f},{:.4f},,,\n", c.label, c.path_mm, c.feed_ratio);
+  return csv;
+}
+
+int run_coupon(const CouponOptions& o) {
+  auto settings = resolve_cam_settings(o.cam);
+  if (!settings) return fail(settings.error());
+  auto material = find_material(settings->materials, o.cam.material.value_or(""));
+  if (!material) return fail(material.error());
+  CouponParams params;
+  params.thickness_mm = o.thickness_mm;
+  auto coupon = calibration_coupon(params, *material, settings->machine.cutting);
+  if (!coupon) return fail(coupon.error());
+  PostParams post = settings->machine.post;
+  post.title = fmt::format("CALIBRATION COUPON {:g}MM {}", o.thickness_mm, material->name);
+  auto program = post_program(coupon->toolpath, settings->machine.head, post);
+  if (!program) return fail(program.error());
+  std::error_code ec;
+  fs::create_directories(o.out_dir, ec);
+  const fs::path dir(o.out_dir);
+  for (auto [name, text] : {std::pair{"coupon.nc", program->text}, std::pair{"coupon.csv", measurement_sheet(*coupon, material->name, o.thickness_mm)}})
+    if (auto w = write_file(dir / name, text); !w) return fail(w.error());
+  fmt::print("{:<12} {:>8} {:>8} {:>10} {:>12}\n", "cut", "path mm", "ratio", "feed mm/min", "v_s mm/min");
+  for (const CouponCut& c : coupon->cuts)
+    fmt::print("{:<12} {:>8.3f} {:>8.3f} {:>10.1f} {:>12.1f}\n", c.label, c.path_mm, c.feed_ratio, c.feed_mm_per_s * 60.0,
+               c.separation_feed_mm_per_s * 60.0);
+  fmt::print("sheet at least {:.0f} x {:.0f} mm; about {:.0f} s of cutting\nwrote {} and {}\n", coupon->length_mm, coupon->width_mm,
+             coupon->toolpath.time.total_s, (dir / "coupon.nc").string(), (dir / "coupon.csv").string());
+  return 0;
+}
+
 }  // namespace
 
 void add_calibrate_command(CLI::App& app, int& exit_code) {
@@ -97,6 +151,14 @@ void add_calibrate_command(CLI::App& app, int& exit_code) {
   fit->add_option("--material", o->material, "the material the coupon was cut from (as in the materials file)")->required();
   fit->add_option("--kerf-file", o->kerf_file, "where calibrations are kept (default: <config>/kerf.toml)");
   fit->add_option("--materials", o->materials_file, "the materials file the name is from (default: <config>/materials.toml)");
+  auto c = std::make_shared<CouponOptions>();
+  auto* coupon = calibrate->add_subcommand("coupon", "Write a test program of labelled slots at several speeds and tilts, and the CSV to measure them into");
+  coupon->add_option("--material", c->cam.material, "the sheet's material (as in the materials file)")->required();
+  coupon->add_option("--thickness", c->thickness_mm, "the sheet's thickness, mm")->required()->check(CLI::PositiveNumber);
+  coupon->add_option("--out", c->out_dir, "folder for coupon.nc and coupon.csv")->required();
+  coupon->add_option("--machine", c->cam.machine_file, "machine file (default: <config>/machine.toml)");
+  coupon->add_option("--materials", c->cam.materials_file, "materials file (default: <config>/materials.toml)");
+  coupon->callback([c, &exit_code] { exit_code = run_coupon(*c); });
   fit->callback([o, &exit_code] {
     if (o->kerf_file.empty()) o->kerf_file = (fs::path(default_config_dir()) / "kerf.toml").string();
     if (o->materials_file.empty()) o->materials_file = (fs::path(default_config_dir()) / "materials.toml").string();

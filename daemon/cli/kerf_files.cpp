@@ -58,6 +58,7 @@ std::expected<std::array<std::size_t, kColumns.size()>, Error> header_columns(co
 }
 
 std::expected<double, Error> number_cell(std::string_view cell, std::string_view column, const std::string& source, std::size_t line) {
+  if (cell.empty()) return std::unexpected(csv_error(source, line, fmt::format("{}: empty (measure the cut and fill it in)", column)));
   double v = 0.0;
   const auto [end, ec] = std::from_chars(cell.data(), cell.data() + cell.size(), v);
   if (cell.empty() || ec != std::errc{} || end != cell.data() + cell.size() || !std::isfinite(v))

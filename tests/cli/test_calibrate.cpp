@@ -116,6 +116,57 @@ TEST(CalibrateFit, ABrokenMeasurementFileIsNamedByLineAndNothingIsWritten) {
   EXPECT_NE(usage.out.find("--material"), std::string::npos) << usage.out;
 }
 
+// The loop a shop runs: the coupon's program and its CSV, the cuts "measured" (here: the truth
+// plus a caliper's noise, at the paths and ratios the CSV lists), the fit.
+TEST(CalibrateCoupon, ItsSheetFilledInFitsBackTheKerf) {
+  TempDir dir("calibrate-coupon");
+  auto r = lamina_cli_test::lamina("calibrate coupon --material 'aluminium 6061-T6' --thickness 10 --out " + quoted(dir.path));
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  ASSERT_TRUE(fs::exists(dir.path / "coupon.nc"));
+  std::ifstream program(dir.path / "coupon.nc");
+  const std::string nc{std::istreambuf_iterator<char>(program), std::istreambuf_iterator<char>()};
+  EXPECT_NE(nc.find("(CONTOUR 0 T0-R0.15 TEST CUT OPEN)"), std::string::npos) << nc.substr(0, 400);
+
+  std::ifstream sheet(dir.path / "coupon.csv");
+  std::ostringstream filled;
+  std::mt19937 rng(11);
+  std::normal_distribution<double> caliper(0.0, 0.01);
+  int rows = 0;
+  for (std::string line; std::getline(sheet, line);) {
+    if (line.empty() || line[0] == '#' || line.starts_with("label,")) {
+      filled << line << "\n";
+      continue;
+    }
+    ASSERT_TRUE(line.ends_with(",,,")) << "measurements left to fill in: " << line;
+    std::istringstream cells(line);
+    std::string label, path, ratio;
+    std::getline(cells, label, ',');
+    std::getline(cells, path, ',');
+    std::getline(cells, ratio, ',');
+    const auto k = *lamina::kerf_at(kTruth, std::stod(path), std::stod(ratio));
+    filled << label << "," << path << "," << ratio << "," << k.top_width_mm + caliper(rng) << ","
+           << k.bottom_width_mm + caliper(rng) << "," << k.trail_back_mm * (1 + caliper(rng)) << "\n";
+    ++rows;
+  }
+  EXPECT_EQ(rows, 10);
+  // Unfilled, the sheet says what is missing.
+  r = lamina_cli_test::lamina("calibrate fit " + quoted(dir.path / "coupon.csv") + " --material 'aluminium 6061-T6' --kerf-file " +
+                              quoted(dir.path / "kerf.toml"));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.out.find("coupon.csv:4: top_width_mm: empty (measure the cut and fill it in)"), std::string::npos) << r.out;
+  std::ofstream(dir.path / "measured.csv") << filled.str();
+  r = lamina_cli_test::lamina("calibrate fit " + quoted(dir.path / "measured.csv") + " --material 'aluminium 6061-T6' --kerf-file " +
+                              quoted(dir.path / "kerf.toml"));
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  std::ifstream in(dir.path / "kerf.toml");
+  auto stored = lamina::cli::parse_kerf_toml(std::string{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()}, "kerf.toml");
+  ASSERT_TRUE(stored) << stored.error().message;
+  const KerfModel& m = stored->at("aluminium 6061-T6").model;
+  EXPECT_NEAR(m.taper_per_ratio, 0.06, 0.006);
+  EXPECT_NEAR(m.taper_free_ratio, 0.3, 0.06);
+  EXPECT_NEAR(m.trail_back_exponent, 2.2, 0.1);
+}
+
 TEST(KerfFile, AHandEditedFileIsCheckedKeyByKey) {
   const std::string good = lamina::cli::kerf_toml({{"brass", {kTruth, 12, 0.01, 0.02, "b.csv"}}});
   auto back = lamina::cli::parse_kerf_toml(good, "kerf.toml");

@@ -140,17 +140,34 @@ double zeng_kim_feed_mm_per_s(const JetSetup& jet, const Material& material, dou
   return u_in_per_min * kMPerInch * 1e3 / kSPerMin;  // in/min → mm/s
 }
 
-std::expected<double, Error> cut_feed_mm_per_s(const JetSetup& jet, const Material& material, const FeedParams& params,
-                                               double thickness_mm, double tilt_rad) {
+namespace {
+
+// The chosen model's feed at this quality, checked and unclamped.
+std::expected<double, Error> model_feed_mm_per_s(const JetSetup& jet, const Material& material, const FeedParams& params,
+                                                 double thickness_mm, double tilt_rad) {
   if (auto r = check_jet(jet); !r) return std::unexpected(r.error());
   if (auto r = check_model_inputs(material, params); !r) return std::unexpected(r.error());
   if (auto r = check_cut(params, thickness_mm, tilt_rad); !r) return std::unexpected(r.error());
   // A tilted jet crosses the sheet along its axis: the depth it must erode is t / cos(tilt).
   const double h_f_mm = thickness_mm / std::cos(tilt_rad);
-  const double feed = params.model == FeedModel::limbachiya_patel
-                          ? limbachiya_patel_feed_mm_per_s(jet, material, h_f_mm)
-                          : zeng_kim_feed_mm_per_s(jet, material, h_f_mm, params.quality);
-  return std::clamp(feed, params.min_feed_mm_per_s, params.max_feed_mm_per_s);
+  return params.model == FeedModel::limbachiya_patel ? limbachiya_patel_feed_mm_per_s(jet, material, h_f_mm)
+                                                     : zeng_kim_feed_mm_per_s(jet, material, h_f_mm, params.quality);
+}
+
+}  // namespace
+
+std::expected<double, Error> cut_feed_mm_per_s(const JetSetup& jet, const Material& material, const FeedParams& params,
+                                               double thickness_mm, double tilt_rad) {
+  auto feed = model_feed_mm_per_s(jet, material, params, thickness_mm, tilt_rad);
+  if (!feed) return feed;
+  return std::clamp(*feed, params.min_feed_mm_per_s, params.max_feed_mm_per_s);
+}
+
+std::expected<double, Error> separation_feed_mm_per_s(const JetSetup& jet, const Material& material, const FeedParams& params,
+                                                      double thickness_mm, double tilt_rad) {
+  FeedParams separation = params;
+  separation.quality = 1;
+  return model_feed_mm_per_s(jet, material, separation, thickness_mm, tilt_rad);
 }
 
 }  // namespace lamina

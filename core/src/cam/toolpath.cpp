@@ -458,20 +458,7 @@ class SheetBuilder {
     out_.contours.push_back(c);
   }
 
-  void sum_time() {
-    CutTime& tm = out_.time;
-    Eigen::Vector3d at = out_.moves.empty() ? Eigen::Vector3d::Zero() : out_.moves.front().tip_mm;
-    for (const ToolMove& m : out_.moves) {
-      const double d = (m.tip_mm - at).norm();
-      switch (m.kind) {
-        case MoveKind::rapid: tm.rapid_s += m.duration_s, tm.rapid_length_mm += d; break;
-        case MoveKind::pierce: tm.pierce_s += m.duration_s, ++tm.pierces; break;
-        default: tm.cutting_s += m.duration_s, tm.cut_length_mm += d; break;
-      }
-      at = m.tip_mm;
-    }
-    tm.total_s = tm.cutting_s + tm.rapid_s + tm.pierce_s;
-  }
+  void sum_time() { out_.time = cut_time(out_.moves); }
 
   const BevelPlan& plan_;
   std::span<const Part> parts_;
@@ -482,6 +469,22 @@ class SheetBuilder {
 };
 
 }  // namespace
+
+CutTime cut_time(std::span<const ToolMove> moves) {
+  CutTime tm;
+  Eigen::Vector3d at = moves.empty() ? Eigen::Vector3d::Zero() : moves.front().tip_mm;
+  for (const ToolMove& m : moves) {
+    const double d = (m.tip_mm - at).norm();
+    switch (m.kind) {
+      case MoveKind::rapid: tm.rapid_s += m.duration_s, tm.rapid_length_mm += d; break;
+      case MoveKind::pierce: tm.pierce_s += m.duration_s, ++tm.pierces; break;
+      default: tm.cutting_s += m.duration_s, tm.cut_length_mm += d; break;
+    }
+    at = m.tip_mm;
+  }
+  tm.total_s = tm.cutting_s + tm.rapid_s + tm.pierce_s;
+  return tm;
+}
 
 std::expected<SheetToolpath, Error> plan_sheet_toolpath(const BevelPlan& plan, std::span<const Part> parts,
                                                         const NestedSheet& sheet, const Material& material,

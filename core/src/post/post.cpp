@@ -48,9 +48,11 @@ struct Writer {
 
 std::string contour_marker(std::size_t index, const ToolContour& c) {
   // The part as the drawing labels it; an outline of -1 is a dowel hole.
+  // No part at all: a test cut of a calibration coupon (coupon.hpp), named by its label.
   const std::string part = c.label.empty() ? fmt::format("PART {}", c.part) : c.label;
-  std::string s = c.outline < 0 ? fmt::format("CONTOUR {} {} DOWEL", index, part)
-                                : fmt::format("CONTOUR {} {} OUTLINE {} PASS {}", index, part, c.outline, c.pass);
+  std::string s = c.part < 0         ? fmt::format("CONTOUR {} {} TEST CUT", index, part)
+                  : c.outline < 0    ? fmt::format("CONTOUR {} {} DOWEL", index, part)
+                                     : fmt::format("CONTOUR {} {} OUTLINE {} PASS {}", index, part, c.outline, c.pass);
   if (c.is_hole) s += " HOLE";
   if (c.frees) s += " FREES";
   if (!c.closed) s += " OPEN";

@@ -70,4 +70,10 @@ double zeng_kim_feed_mm_per_s(const JetSetup& jet, const Material& material, dou
 std::expected<double, Error> cut_feed_mm_per_s(const JetSetup& jet, const Material& material,
                                                const FeedParams& params, double thickness_mm, double tilt_rad);
 
+// The separation speed v_s at this path (mm/s, not clamped): the feed that just cuts through —
+// Zeng & Kim's quality 1, or eq. 3 (whose μ_job is calibrated to it). The kerf model's feed
+// ratio is a feed over this (kerf.hpp). Same checks and errors as cut_feed_mm_per_s.
+std::expected<double, Error> separation_feed_mm_per_s(const JetSetup& jet, const Material& material,
+                                                      const FeedParams& params, double thickness_mm, double tilt_rad);
+
 }  // namespace lamina

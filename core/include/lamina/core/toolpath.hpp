@@ -103,6 +103,9 @@ struct ToolpathParams {
   FeedParams feed;
 };
 
+// The times and lengths of a list of moves (rapids at their distance, pierces counted).
+CutTime cut_time(std::span<const ToolMove> moves);
+
 // The toolpath of one nested sheet. material is the sheet's; plan and parts are what the nest was
 // made from. Holes of a part are cut before its outer outline; trim runs before the freeing pass.
 std::expected<SheetToolpath, Error> plan_sheet_toolpath(const BevelPlan& plan, std::span<const Part> parts,
