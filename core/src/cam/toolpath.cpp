@@ -8,6 +8,7 @@
 // stays in the sheet until its last pass.
 #include "lamina/core/toolpath.hpp"
 
+#include "cam/jet_compensation.hpp"
 #include "cam/toolpath_ring.hpp"
 
 #include <fmt/format.h>
@@ -183,6 +184,28 @@ class SheetBuilder {
     return {};
   }
 
+  // The jet's real kerf (JetCompensation): each line's separation speed at its tilt, the
+  // material's kerf model, and the lines the tilt limit held back counted for the report.
+  std::expected<void, Error> compensate_jet(std::vector<PathPoint>& pts, const std::string& where) {
+    const JetCompensation& jc = p_.jet_compensation;
+    if (jc.mode == JetCompensationMode::off) return {};
+    const auto model = jc.kerf_by_material.find(material_.name);
+    if (model == jc.kerf_by_material.end())
+      return std::unexpected(invalid(fmt::format("{}: no kerf calibration for '{}' (lamina calibrate coupon, then fit; docs/jet.md)",
+                                                 where, material_.name)));
+    std::vector<double> separation;
+    for (const PathPoint& q : pts) {
+      auto v = separation_feed_mm_per_s(p_.jet, material_, p_.feed, sheet_.thickness_mm, std::acos(std::clamp(q.axis.z(), -1.0, 1.0)));
+      if (!v) return std::unexpected(Error{v.error().code, where + ": " + v.error().message});
+      separation.push_back(*v);
+    }
+    const cam_detail::JetCompensationInput in{jc.mode, &model->second, sheet_.thickness_mm, 0.5 * p_.kerf_mm, jc.tilt_max_rad, true};
+    auto held = cam_detail::compensate_jet(pts, separation, in);
+    if (!held) return std::unexpected(Error{held.error().code, where + ", " + held.error().message});
+    out_.jet_tilt_limited += *held;
+    return {};
+  }
+
   // A trimming pass (every pass before the freeing one): only where its lines differ from the
   // freeing pass's, as runs with one shared line on either side; a pass that differs nearly all
   // round is opened at the microjoints, or at one bridge where it is thinnest.
@@ -244,6 +267,7 @@ class SheetBuilder {
       passes.push_back(cam_detail::compensate_pass(outline, pass, frame, p_.part_on_right, h));
       if (auto ok = feed_points(passes.back().points, where); !ok) return ok;
       cam_detail::mark_corners(passes.back().points, p_.corner_angle_rad, p_.corner_min_fraction);
+      if (auto ok = compensate_jet(passes.back().points, where); !ok) return ok;
     }
     // Microjoints on the outer outline's freeing pass, as station parameters so every pass of the
     // outline leaves them at the same place.

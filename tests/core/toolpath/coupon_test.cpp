@@ -3,6 +3,7 @@
 // apart from its neighbours, and through the same post as every sheet.
 #include "lamina/core/coupon.hpp"
 #include "lamina/core/post.hpp"
+#include "toolpath_fixture.hpp"
 
 #include <gtest/gtest.h>
 
@@ -14,13 +15,6 @@ namespace lamina {
 namespace {
 
 constexpr double kDeg = std::numbers::pi / 180.0;
-
-Material aluminium() {
-  Material m;
-  m.name = "aluminium";
-  m.machinability = 213;
-  return m;
-}
 
 TEST(CalibrationCoupon, EverySlotIsCutAtItsRatioTiltAndPath) {
   const ToolpathParams params;

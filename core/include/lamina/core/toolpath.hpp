@@ -7,6 +7,7 @@
 #include "lamina/core/bevel.hpp"
 #include "lamina/core/error.hpp"
 #include "lamina/core/feed.hpp"
+#include "lamina/core/kerf.hpp"
 #include "lamina/core/nest.hpp"
 #include "lamina/core/parts.hpp"
 
@@ -15,6 +16,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <expected>
+#include <map>
 #include <span>
 #include <string>
 #include <vector>
@@ -77,10 +79,22 @@ struct CutTime {
 struct SheetToolpath {
   int sheet = 0;  // NestedSheet::index
   double thickness_mm = 0.0;
+  std::size_t jet_tilt_limited = 0;  // cut lines whose compensation the tilt limit cut short
   std::vector<ToolMove> moves;  // starts with a rapid to the park position at safe height, ends with one back to it
   std::vector<ToolContour> contours;
   std::vector<Microjoint> microjoints;
   CutTime time;
+};
+
+// Compensation of the jet's real kerf (kerf.hpp, docs/jet.md): off keeps today's programs bit
+// for bit; taper offsets the top and the bottom of every cut line by their own half widths, which
+// turns the axis about the travel so the part's wall runs along the planned line; full also aims
+// the exit ahead of the line by the trail-back, leaning the axis along the travel.
+enum class JetCompensationMode : std::uint8_t { off, taper, full };
+struct JetCompensation {
+  JetCompensationMode mode = JetCompensationMode::off;
+  std::map<std::string, KerfModel, std::less<>> kerf_by_material;  // a sheet's material must be here when on
+  double tilt_max_rad = 1.0471975511965976;  // the head's limit: beyond it the line is held at it and counted
 };
 
 struct ToolpathParams {
@@ -101,6 +115,7 @@ struct ToolpathParams {
   Eigen::Vector2d park_mm = Eigen::Vector2d::Zero();  // where the head waits before and after the sheet
   JetSetup jet;
   FeedParams feed;
+  JetCompensation jet_compensation;
 };
 
 // The times and lengths of a list of moves (rapids at their distance, pierces counted).

@@ -1,0 +1,140 @@
+// Jet compensation in the toolpath (issue 20, toolpath.hpp's JetCompensation): with the jet's
+// real kerf, the part's wall must run along the planned line — the top offset by the model's half
+// top width, the bottom by its half bottom width, and (full) the exit aimed ahead by the
+// trail-back — while off leaves every program as it was, byte for byte.
+#include "toolpath_fixture.hpp"
+
+#include <lamina/core/post.hpp>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace lamina {
+namespace {
+
+const KerfModel kKerf{.top_width_mm = 1.2,
+                      .top_width_per_ratio_mm = 0.0,
+                      .taper_per_ratio = 0.1,
+                      .taper_free_ratio = 0.1,
+                      .trail_back_factor = 0.2,
+                      .trail_back_exponent = 2.0};
+constexpr double kHalfSide = 20.0, kThickness = 5.0, kKerfMm = 1.0;
+const Eigen::Vector2d kCentre(100, 50);
+
+// A 40 mm square of 5 mm plate, vertical walls, centred at kCentre on the sheet.
+Fixture square() {
+  return one_part(dev_test::make_layer(0, 0.0, kThickness, {dev_test::square_outline({0, 0}, kHalfSide, 0, kThickness)}), 0.0, kCentre, kKerfMm);
+}
+
+ToolpathParams with(JetCompensationMode mode) {
+  ToolpathParams p;
+  p.kerf_mm = kKerfMm;
+  p.jet_compensation.mode = mode;
+  p.jet_compensation.kerf_by_material.emplace("aluminium", kKerf);
+  return p;
+}
+
+// The kerf the model gives at this sheet and the toolpath's feed on a straight edge.
+KerfShape expected_kerf(const ToolpathParams& p) {
+  const double feed = *cut_feed_mm_per_s(p.jet, aluminium(), p.feed, kThickness, 0.0);
+  const double v_s = *separation_feed_mm_per_s(p.jet, aluminium(), p.feed, kThickness, 0.0);
+  return *kerf_at(kKerf, kThickness, feed / v_s);
+}
+
+struct EdgeMove {
+  Eigen::Vector3d tip, bottom, travel;
+};
+
+// Cut moves in the middle of the outer square's edges (the corners' mitres left out).
+std::vector<EdgeMove> edge_moves(const SheetToolpath& tp) {
+  std::vector<EdgeMove> out;
+  const ToolContour& outer = tp.contours.back();
+  for (std::size_t i = outer.first_move + 1; i < outer.end_move; ++i) {
+    const ToolMove& m = tp.moves[i];
+    if (m.kind != MoveKind::cut) continue;
+    const Eigen::Vector2d d = (m.tip_mm.head<2>() - kCentre).cwiseAbs();
+    if (std::min(d.x(), d.y()) > kHalfSide - 5.0) continue;
+    const Eigen::Vector3d bottom = m.tip_mm - m.axis * (kThickness / m.axis.z());
+    // Along the edge: the previous tip may be a corner's mitre, a little off the edge's line.
+    const Eigen::Vector3d step = m.tip_mm - tp.moves[i - 1].tip_mm;
+    const Eigen::Vector3d along = d.x() > d.y() ? Eigen::Vector3d(0, std::copysign(1.0, step.y()), 0)
+                                                : Eigen::Vector3d(std::copysign(1.0, step.x()), 0, 0);
+    out.push_back({m.tip_mm, bottom, along});
+  }
+  return out;
+}
+
+double outside_square(const Eigen::Vector3d& p) { return (p.head<2>() - kCentre).cwiseAbs().maxCoeff() - kHalfSide; }
+
+TEST(JetCompensation, TaperPutsThePartsWallOnThePlannedLineAtBothFaces) {
+  auto f = square();
+  const ToolpathParams p = with(JetCompensationMode::taper);
+  auto tp = plan_sheet_toolpath(f.plan, f.parts, f.sheet, aluminium(), p);
+  ASSERT_TRUE(tp) << tp.error().message;
+  const KerfShape k = expected_kerf(p);
+  ASSERT_GT(k.top_width_mm - k.bottom_width_mm, 0.05) << "a visible taper";
+  const auto moves = edge_moves(*tp);
+  ASSERT_EQ(moves.size(), 4u) << "one mid-edge station per side";
+  for (const EdgeMove& m : moves) {
+    // The jet's centre at half its own width from the planned (vertical) wall, at each face.
+    EXPECT_NEAR(outside_square(m.tip), k.top_width_mm / 2.0, 1e-9) << m.tip.transpose();
+    EXPECT_NEAR(outside_square(m.bottom), k.bottom_width_mm / 2.0, 1e-9) << m.bottom.transpose();
+    EXPECT_NEAR(m.bottom.z(), -kThickness, 1e-9);
+  }
+  EXPECT_EQ(tp->jet_tilt_limited, 0u);
+}
+
+TEST(JetCompensation, FullAimsTheExitAheadByTheTrailBack) {
+  auto f = square();
+  const ToolpathParams p = with(JetCompensationMode::full);
+  auto tp = plan_sheet_toolpath(f.plan, f.parts, f.sheet, aluminium(), p);
+  ASSERT_TRUE(tp) << tp.error().message;
+  const KerfShape k = expected_kerf(p);
+  ASSERT_GT(k.trail_back_mm, 0.01);
+  for (const EdgeMove& m : edge_moves(*tp)) {
+    const Eigen::Vector3d lead = m.bottom - m.tip;
+    EXPECT_NEAR(lead.dot(m.travel), k.trail_back_mm, 1e-6) << "the bottom leads the tip along the travel";
+    EXPECT_NEAR(outside_square(m.bottom), k.bottom_width_mm / 2.0, 1e-9);
+  }
+}
+
+TEST(JetCompensation, OffKeepsTheProgramByteForByte) {
+  auto f = square();
+  ToolpathParams plain;
+  plain.kerf_mm = kKerfMm;
+  const ToolpathParams off = with(JetCompensationMode::off);
+  auto a = plan_sheet_toolpath(f.plan, f.parts, f.sheet, aluminium(), plain);
+  auto b = plan_sheet_toolpath(f.plan, f.parts, f.sheet, aluminium(), off);
+  ASSERT_TRUE(a && b);
+  HeadKinematics head;
+  head.rtcp = false;
+  EXPECT_EQ(post_program(*a, head, PostParams{})->text, post_program(*b, head, PostParams{})->text);
+  auto c = plan_sheet_toolpath(f.plan, f.parts, f.sheet, aluminium(), with(JetCompensationMode::taper));
+  ASSERT_TRUE(c);
+  EXPECT_NE(post_program(*a, head, PostParams{})->text, post_program(*c, head, PostParams{})->text) << "taper changes it";
+}
+
+TEST(JetCompensation, TheTiltLimitHoldsTheLineAndIsCounted) {
+  auto f = square();
+  ToolpathParams p = with(JetCompensationMode::full);
+  p.jet_compensation.tilt_max_rad = 0.002;  // 0.1°: less than the taper asks
+  auto tp = plan_sheet_toolpath(f.plan, f.parts, f.sheet, aluminium(), p);
+  ASSERT_TRUE(tp) << tp.error().message;
+  EXPECT_GT(tp->jet_tilt_limited, 0u);
+  for (const ToolMove& m : tp->moves)
+    if (m.kind == MoveKind::cut) EXPECT_LE(std::acos(m.axis.z()), 0.002 + 1e-9);
+}
+
+TEST(JetCompensation, AMaterialWithoutCalibrationIsNamed) {
+  auto f = square();
+  ToolpathParams p = with(JetCompensationMode::taper);
+  p.jet_compensation.kerf_by_material.clear();
+  p.jet_compensation.kerf_by_material.emplace("mild steel", kKerf);
+  auto tp = plan_sheet_toolpath(f.plan, f.parts, f.sheet, aluminium(), p);
+  ASSERT_FALSE(tp);
+  EXPECT_NE(tp.error().message.find("no kerf calibration for 'aluminium'"), std::string::npos) << tp.error().message;
+}
+
+}  // namespace
+}  // namespace lamina
