@@ -149,7 +149,7 @@ void add_calibrate_command(CLI::App& app, int& exit_code) {
   fit->add_option("measurements", o->measurements, "CSV: label,path_mm,feed_ratio,top_width_mm,bottom_width_mm,trail_back_mm")
       ->required();
   fit->add_option("--material", o->material, "the material the coupon was cut from (as in the materials file)")->required();
-  fit->add_option("--kerf-file", o->kerf_file, "where calibrations are kept (default: <config>/kerf.toml)");
+  fit->add_option("--kerf-file", o->kerf_file, "where calibrations are kept (default: kerf.toml beside the materials file)");
   fit->add_option("--materials", o->materials_file, "the materials file the name is from (default: <config>/materials.toml)");
   auto c = std::make_shared<CouponOptions>();
   auto* coupon = calibrate->add_subcommand("coupon", "Write a test program of labelled slots at several speeds and tilts, and the CSV to measure them into");
@@ -160,8 +160,9 @@ void add_calibrate_command(CLI::App& app, int& exit_code) {
   coupon->add_option("--materials", c->cam.materials_file, "materials file (default: <config>/materials.toml)");
   coupon->callback([c, &exit_code] { exit_code = run_coupon(*c); });
   fit->callback([o, &exit_code] {
-    if (o->kerf_file.empty()) o->kerf_file = (fs::path(default_config_dir()) / "kerf.toml").string();
     if (o->materials_file.empty()) o->materials_file = (fs::path(default_config_dir()) / "materials.toml").string();
+    // Beside the materials file: where lamina plan looks for it.
+    if (o->kerf_file.empty()) o->kerf_file = (fs::path(o->materials_file).parent_path() / "kerf.toml").string();
     exit_code = run_fit(*o);
   });
 }

@@ -1,5 +1,8 @@
 #include "plan_cam.hpp"
 
+#include "kerf_files.hpp"
+#include "toml_file.hpp"
+
 
 #include <fmt/format.h>
 
@@ -12,6 +15,30 @@ namespace lamina::cli {
 namespace {
 
 Error usage(std::string m) { return {ErrorCode::invalid_argument, std::move(m)}; }
+
+// The kerf calibrations for --jet-compensation: read when there are some. auto without any is
+// today's programs; taper or full without the file, or a --kerf-file that is not there, is an error.
+std::expected<void, Error> resolve_jet_compensation(const CamOptions& o, CamSettings& s) {
+  JetCompensation& jc = s.machine.cutting.jet_compensation;
+  jc.mode = o.jet_compensation ? jet_compensation_modes().parse(*o.jet_compensation).value() : JetCompensationMode::automatic;
+  jc.tilt_max_rad = std::min(-s.machine.head.a_min_rad, s.machine.head.a_max_rad);
+  if (jc.mode == JetCompensationMode::off) return {};
+  const std::filesystem::path file =
+      o.kerf_file.empty() ? std::filesystem::path(s.materials_source).parent_path() / "kerf.toml" : std::filesystem::path(o.kerf_file);
+  if (!std::filesystem::exists(file)) {
+    if (jc.mode == JetCompensationMode::automatic && o.kerf_file.empty()) return {};
+    return std::unexpected(usage(fmt::format("--jet-compensation {}: no kerf calibrations in {} (lamina calibrate coupon, then "
+                                             "lamina calibrate fit; docs/jet.md)",
+                                             jet_compensation_name(jc.mode), file.string())));
+  }
+  auto text = read_config_file(file.string(), "kerf");
+  if (!text) return std::unexpected(text.error());
+  auto calibrations = parse_kerf_toml(*text, file.string());
+  if (!calibrations) return std::unexpected(calibrations.error());
+  for (const auto& [material, k] : *calibrations) jc.kerf_by_material.emplace(material, k.model);
+  s.kerf_source = file.string();
+  return {};
+}
 
 }  // namespace
 
@@ -37,6 +64,10 @@ void add_cam_options(CLI::App& cmd, CamOptions& o) {
   cmd.add_option("--dowels", o.dowels, "Registration dowel holes through every layer (0: none)")->check(CLI::Range(0, 64));
   cmd.add_option("--dowel-diameter", o.dowel_diameter_mm, "Dowel hole diameter (mm)")->check(CLI::Range(0.5, 100.0));
   cmd.add_option("--fill-holes", o.fill_holes, "Nest smaller parts inside the holes of larger ones (true/false)");
+  cmd.add_option("--jet-compensation", o.jet_compensation,
+                 "The jet's real kerf (docs/jet.md): auto (full where the material is calibrated), off, taper or full")
+      ->check(CLI::IsMember(jet_compensation_modes().names()));
+  cmd.add_option("--kerf-file", o.kerf_file, "Kerf calibrations (lamina calibrate fit; default: kerf.toml beside the materials file)");
   cmd.add_flag("--no-programs", o.no_programs, "Stop after the stack: no nesting, programs or sheet drawings");
 }
 
@@ -86,6 +117,7 @@ std::expected<CamSettings, Error> resolve_cam_settings(const CamOptions& o) {
                                              "--post {} for a controller that keeps the tool tip",
                                              dialect->traits.controller, fmt::join(with_rtcp, " / "))));
   }
+  if (auto jet = resolve_jet_compensation(o, s); !jet) return std::unexpected(jet.error());
   // A pierce in the gap between two parts must not land in the neighbour.
   if (m.nest.spacing_mm < m.cutting.lead_in_mm + m.cutting.kerf_mm)
     return std::unexpected(usage(fmt::format(

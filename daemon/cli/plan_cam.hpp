@@ -26,6 +26,8 @@ struct CamOptions {
       dowel_diameter_mm;
   std::optional<int> dowels, microjoints, quality;
   std::optional<bool> rtcp, fill_holes;
+  std::optional<std::string> jet_compensation;  // auto (default), off, taper, full
+  std::string kerf_file;                        // default: kerf.toml beside the materials file
   bool no_programs = false;  // stop after the stack (no nesting, programs, drawings)
 };
 

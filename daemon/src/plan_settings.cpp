@@ -55,6 +55,7 @@ const std::vector<Setting>& settings_table() {
       {"dowels", "--dowels", Kind::integer, 0, 64},
       {"dowel_diameter_mm", "--dowel-diameter", Kind::number, 0.5, 100},
       {"fill_holes", "--fill-holes", Kind::boolean},
+      {"jet_compensation", "--jet-compensation", Kind::text, 0, 0, jet_compensation_modes().names()},
   };
   return table;
 }

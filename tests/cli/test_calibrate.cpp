@@ -6,6 +6,7 @@
 #include "kerf_files.hpp"
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <fstream>
 #include <random>
@@ -165,6 +166,52 @@ TEST(CalibrateCoupon, ItsSheetFilledInFitsBackTheKerf) {
   EXPECT_NEAR(m.taper_per_ratio, 0.06, 0.006);
   EXPECT_NEAR(m.taper_free_ratio, 0.3, 0.06);
   EXPECT_NEAR(m.trail_back_exponent, 2.2, 0.1);
+}
+
+std::string read_text(const fs::path& p) {
+  std::ifstream in(p);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// `lamina plan` with a calibration: auto compensates the calibrated material, off and an
+// uncalibrated shop keep today's programs byte for byte, and asking for compensation without a
+// calibration is an error that says what to do.
+TEST(PlanJetCompensation, ACalibratedMaterialIsCompensatedAndOffChangesNothing) {
+  TempDir dir("plan-jet");
+  std::ofstream(dir.path / "kerf.toml") << lamina::cli::kerf_toml({{"aluminium 6061-T6", {kTruth, 10, 0.01, 0.02, "al.csv"}}});
+  const std::string knob = quoted(fs::path(LAMINA_EXAMPLES_DIR) / "knob.stl") + " --stock 5";
+  const auto plan = [&](const std::string& name, const std::string& extra) {
+    return lamina_cli_test::lamina("plan " + knob + " --out " + quoted(dir.path / name) + " " + extra);
+  };
+  auto r = plan("off", "--jet-compensation off");
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  r = plan("uncalibrated", "");  // auto, and no kerf.toml beside config/materials.toml
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  r = plan("auto", "--kerf-file " + quoted(dir.path / "kerf.toml"));
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  EXPECT_EQ(read_text(dir.path / "off/sheet-1.nc"), read_text(dir.path / "uncalibrated/sheet-1.nc"));
+  EXPECT_NE(read_text(dir.path / "off/sheet-1.nc"), read_text(dir.path / "auto/sheet-1.nc"));
+  const auto report = nlohmann::json::parse(read_text(dir.path / "auto/report.json"));
+  EXPECT_EQ(report["cam"]["jet_compensation"], "auto");
+  EXPECT_EQ(report["cam"]["kerf_file"], (dir.path / "kerf.toml").string());
+  for (const auto& sheet : report["sheets"]) {
+    EXPECT_EQ(sheet["jet_compensation"], "full") << sheet.dump();
+    // The knob's grooves are bevelled at the 60° limit already: those lines cannot lean further.
+    EXPECT_GT(sheet["jet_tilt_limited"].get<int>(), 0) << sheet.dump();
+  }
+  const auto plain = nlohmann::json::parse(read_text(dir.path / "uncalibrated/report.json"));
+  EXPECT_EQ(plain["sheets"][0]["jet_compensation"], "off");
+  EXPECT_FALSE(plain["cam"].contains("kerf_file"));
+
+  r = plan("missing", "--jet-compensation taper --kerf-file " + quoted(dir.path / "nothing.toml"));
+  EXPECT_EQ(r.exit_code, 2) << r.out;
+  EXPECT_NE(r.out.find("--jet-compensation taper: no kerf calibrations in"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("lamina calibrate coupon"), std::string::npos) << r.out;
+  // A material the file does not know: named, when compensation is asked for outright.
+  std::ofstream(dir.path / "steel.toml") << lamina::cli::kerf_toml({{"mild steel", {kTruth, 10, 0.01, 0.02, "s.csv"}}});
+  r = plan("steel", "--jet-compensation full --kerf-file " + quoted(dir.path / "steel.toml"));
+  EXPECT_NE(r.exit_code, 0) << r.out;
+  EXPECT_NE(r.out.find("no kerf calibration for 'aluminium 6061-T6'"), std::string::npos) << r.out;
 }
 
 TEST(KerfFile, AHandEditedFileIsCheckedKeyByKey) {

@@ -190,6 +190,7 @@ class SheetBuilder {
     const JetCompensation& jc = p_.jet_compensation;
     if (jc.mode == JetCompensationMode::off) return {};
     const auto model = jc.kerf_by_material.find(material_.name);
+    if (model == jc.kerf_by_material.end() && jc.mode == JetCompensationMode::automatic) return {};
     if (model == jc.kerf_by_material.end())
       return std::unexpected(invalid(fmt::format("{}: no kerf calibration for '{}' (lamina calibrate coupon, then fit; docs/jet.md)",
                                                  where, material_.name)));
@@ -199,7 +200,9 @@ class SheetBuilder {
       if (!v) return std::unexpected(Error{v.error().code, where + ": " + v.error().message});
       separation.push_back(*v);
     }
-    const cam_detail::JetCompensationInput in{jc.mode, &model->second, sheet_.thickness_mm, 0.5 * p_.kerf_mm, jc.tilt_max_rad, true};
+    const JetCompensationMode mode = jc.mode == JetCompensationMode::automatic ? JetCompensationMode::full : jc.mode;
+    out_.jet_compensation = mode;
+    const cam_detail::JetCompensationInput in{mode, &model->second, sheet_.thickness_mm, 0.5 * p_.kerf_mm, jc.tilt_max_rad, true};
     auto held = cam_detail::compensate_jet(pts, separation, in);
     if (!held) return std::unexpected(Error{held.error().code, where + ", " + held.error().message});
     out_.jet_tilt_limited += *held;
@@ -493,6 +496,22 @@ class SheetBuilder {
 };
 
 }  // namespace
+
+const ChoiceTable<JetCompensationMode>& jet_compensation_modes() {
+  static constexpr Choice<JetCompensationMode> rows[] = {
+      {JetCompensationMode::automatic, "auto", "full where the material has a kerf calibration, off where not"},
+      {JetCompensationMode::off, "off", "the jet's kerf as one width along the axis (programs as before)"},
+      {JetCompensationMode::taper, "taper", "top and bottom offset by the kerf model's own widths"},
+      {JetCompensationMode::full, "full", "taper, and the exit aimed ahead by the trail-back"}};
+  static constexpr ChoiceTable<JetCompensationMode> table{"jet compensation", rows};
+  return table;
+}
+
+const char* jet_compensation_name(JetCompensationMode mode) {
+  for (const auto& row : jet_compensation_modes().rows())
+    if (row.value == mode) return row.name.data();
+  return "off";
+}
 
 CutTime cut_time(std::span<const ToolMove> moves) {
   CutTime tm;

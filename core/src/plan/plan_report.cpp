@@ -89,6 +89,8 @@ ReportCam cam_report(const CamSettings& s, const CamResult& r) {
   c.post = post_dialect_name(m.post.dialect);
   c.rtcp = m.head.rtcp;
   c.head = ReportHead{m.head.pivot_mm, m.head.a_sign, m.head.c_sign, m.head.c_offset_rad / kDeg};
+  c.jet_compensation = jet_compensation_name(m.cutting.jet_compensation.mode);
+  if (!s.kerf_source.empty()) c.kerf_file = s.kerf_source;
   c.feed_model = feed_model_name(m.cutting.feed.model);
   c.quality = m.cutting.feed.quality;
   c.kerf_mm = m.cutting.kerf_mm;
@@ -138,6 +140,8 @@ ReportSheet sheet_report(const SheetOutput& s, const std::vector<Part>& parts) {
   if (prog.five_axis_moves) r.bytes_per_five_axis_move = static_cast<double>(prog.five_axis_bytes) / prog.five_axis_moves;
   for (const Placement& pl : s.sheet.placements) r.parts.push_back(part_report(s, pl, parts));
   r.setup_lines = static_cast<std::int64_t>(prog.setup_lines);
+  r.jet_compensation = jet_compensation_name(s.toolpath.jet_compensation);
+  r.jet_tilt_limited = static_cast<std::int64_t>(s.toolpath.jet_tilt_limited);
   for (std::size_t c = 0; c < prog.contour_lines.size(); ++c)
     r.contour_lines.push_back({static_cast<std::int64_t>(c), static_cast<std::int64_t>(prog.contour_lines[c]),
                              static_cast<std::int64_t>(prog.contour_last_cut_lines[c])});

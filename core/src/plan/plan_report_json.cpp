@@ -134,8 +134,8 @@ struct Fields<ReportCam> {
       Field{"lead_out_mm", &S::lead_out_mm},   Field{"pierce_dwell_s", &S::pierce_dwell_s}, Field{"microjoints", &S::microjoints},
       Field{"microjoint_width_mm", &S::microjoint_width_mm}, Field{"dowels", &S::dowels},
       Field{"dowel_diameter_mm", &S::dowel_diameter_mm},     Field{"parts", &S::parts},
-      Field{"timing_s", &S::timing_s}};
-  static constexpr bool omit_empty(std::string_view key) { return key == "head"; }
+      Field{"timing_s", &S::timing_s}, Field{"jet_compensation", &S::jet_compensation}, Field{"kerf_file", &S::kerf_file}};
+  static constexpr bool omit_empty(std::string_view key) { return key == "head" || key == "jet_compensation" || key == "kerf_file"; }
 };
 template <>
 struct Fields<ReportPart> {
@@ -182,8 +182,10 @@ struct Fields<ReportSheet> {
       Field{"bytes_per_five_axis_move", &S::bytes_per_five_axis_move},
       Field{"parts", &S::parts},
       Field{"setup_lines", &S::setup_lines},
-      Field{"contour_lines", &S::contour_lines}};
-  static constexpr bool omit_empty(std::string_view key) { return key == "slot"; }
+      Field{"contour_lines", &S::contour_lines},
+      Field{"jet_compensation", &S::jet_compensation},
+      Field{"jet_tilt_limited", &S::jet_tilt_limited}};
+  static constexpr bool omit_empty(std::string_view key) { return key == "slot" || key == "jet_compensation" || key == "jet_tilt_limited"; }
 };
 template <>
 struct Fields<PlanReport> {

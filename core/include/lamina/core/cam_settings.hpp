@@ -41,6 +41,7 @@ struct CamSettings {
   std::string material_override;  // every sheet is cut as this material ("" : the stock's)
   PartParams parts;
   std::string machine_source, materials_source;  // where they were read, for the report
+  std::string kerf_source;  // the kerf calibrations' file, when one was read (docs/jet.md)
 };
 
 }  // namespace lamina

@@ -100,6 +100,7 @@ struct ReportCam {
   std::string post;
   bool rtcp = false;
   std::optional<ReportHead> head;  // absent in reports written before it (0.7.0 and older)
+  std::optional<std::string> jet_compensation, kerf_file;  // as asked ("auto"…), and the calibrations' file; absent before 0.8
   std::string feed_model;
   std::int64_t quality = 0;
   double kerf_mm = 0.0, lead_in_mm = 0.0, lead_out_mm = 0.0, pierce_dwell_s = 0.0;
@@ -147,6 +148,8 @@ struct ReportSheet {
   std::vector<ReportPart> parts;
   std::int64_t setup_lines = 0;  // the program's set-up: its lines before the first contour
   std::vector<ReportContour> contour_lines;
+  std::optional<std::string> jet_compensation;  // what this sheet got: off, taper, full (absent before 0.8)
+  std::optional<std::int64_t> jet_tilt_limited;  // its cut lines whose compensation the tilt limit held back
 };
 
 struct PlanReport {

@@ -5,6 +5,7 @@
 // z = 0 on the sheet's top face, its bottom at z = −thickness. The tool tip is where the jet's
 // axis crosses the top face; the machine's standoff is above it and belongs to the kinematics.
 #include "lamina/core/bevel.hpp"
+#include "lamina/core/choices.hpp"
 #include "lamina/core/error.hpp"
 #include "lamina/core/feed.hpp"
 #include "lamina/core/kerf.hpp"
@@ -76,21 +77,27 @@ struct CutTime {
   int pierces = 0;
 };
 
+// Compensation of the jet's real kerf (kerf.hpp, docs/jet.md): off keeps today's programs bit
+// for bit; taper offsets the top and the bottom of every cut line by their own half widths, which
+// turns the axis about the travel so the part's wall runs along the planned line; full also aims
+// the exit ahead of the line by the trail-back, leaning the axis along the travel; automatic is
+// full for a material with a calibration and off for one without (the default).
+enum class JetCompensationMode : std::uint8_t { off, taper, full, automatic };
+const ChoiceTable<JetCompensationMode>& jet_compensation_modes();  // "auto", "off", "taper", "full"
+const char* jet_compensation_name(JetCompensationMode mode);
 struct SheetToolpath {
   int sheet = 0;  // NestedSheet::index
   double thickness_mm = 0.0;
-  std::size_t jet_tilt_limited = 0;  // cut lines whose compensation the tilt limit cut short
+  JetCompensationMode jet_compensation = JetCompensationMode::off;  // what this sheet got (never automatic)
+  // Lines of the sheet's passes (trimming passes included, cut or not) whose compensation the
+  // tilt limit held back: lines planned at the limit already cannot lean further.
+  std::size_t jet_tilt_limited = 0;
   std::vector<ToolMove> moves;  // starts with a rapid to the park position at safe height, ends with one back to it
   std::vector<ToolContour> contours;
   std::vector<Microjoint> microjoints;
   CutTime time;
 };
 
-// Compensation of the jet's real kerf (kerf.hpp, docs/jet.md): off keeps today's programs bit
-// for bit; taper offsets the top and the bottom of every cut line by their own half widths, which
-// turns the axis about the travel so the part's wall runs along the planned line; full also aims
-// the exit ahead of the line by the trail-back, leaning the axis along the travel.
-enum class JetCompensationMode : std::uint8_t { off, taper, full };
 struct JetCompensation {
   JetCompensationMode mode = JetCompensationMode::off;
   std::map<std::string, KerfModel, std::less<>> kerf_by_material;  // a sheet's material must be here when on
