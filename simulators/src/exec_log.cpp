@@ -18,12 +18,17 @@ nlohmann::json axes_json(const AxisValues& axes) {
 
 }  // namespace
 
-nlohmann::json to_json_record(const MachineEvent& event) {
+nlohmann::json to_json_record(const MachineEvent& event, const std::optional<HeadGeometry>& head) {
   if (const auto* b = std::get_if<ExecutedBlock>(&event)) {
     nlohmann::json r{{"seq", b->seq},       {"line", b->line},       {"start", axes_json(b->start)},
                      {"end", axes_json(b->end)}, {"jet", b->jet}, {"t_start", b->t_start_s},
                      {"t_end", b->t_end_s}};
     if (!b->completed) r["completed"] = false;
+    if (head) {
+      const JetPose pose = jet_pose(b->end, *head);
+      r["tip"] = pose.tip_mm;
+      r["axis"] = pose.axis;
+    }
     return r;
   }
   if (const auto* s = std::get_if<StarvationEvent>(&event))
@@ -32,7 +37,7 @@ nlohmann::json to_json_record(const MachineEvent& event) {
   return {{"event", "alarm"}, {"t", a.t_s}, {"code", static_cast<int>(a.code)}, {"seq", a.seq}};
 }
 
-ExecLog::ExecLog(const std::string& path) {
+ExecLog::ExecLog(const std::string& path, std::optional<HeadGeometry> head) : head_(head) {
   if (path.empty()) return;
   file_ = std::fopen(path.c_str(), "w");
   if (!file_)
@@ -43,7 +48,7 @@ ExecLog::~ExecLog() {
   if (file_) std::fclose(file_);
 }
 
-void ExecLog::write(const MachineEvent& event) { write_line(to_json_record(event)); }
+void ExecLog::write(const MachineEvent& event) { write_line(to_json_record(event, head_)); }
 
 void ExecLog::write_event(std::string_view name, double t_s, nlohmann::json fields) {
   fields["event"] = name;

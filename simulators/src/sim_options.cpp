@@ -3,6 +3,8 @@
 #include <stdexcept>
 
 #include <fmt/format.h>
+
+#include <cmath>
 #include <toml++/toml.h>
 
 namespace lamina::sim {
@@ -46,6 +48,20 @@ std::vector<int> read_codes(const std::string& path, const std::string& key, con
   return out;
 }
 
+// One head_* key into the head (made on the first of them; the others keep their defaults).
+void read_head(const std::string& path, const std::string& key, const toml::node& node, HeadGeometry& head) {
+  const auto number = node.value<double>();
+  if (key == "head_pivot_mm" && number && *number >= 0) head.pivot_mm = *number;
+  else if ((key == "head_a_sign" || key == "head_c_sign") && number && (*number == 1 || *number == -1))
+    (key == "head_a_sign" ? head.a_sign : head.c_sign) = static_cast<int>(*number);
+  else if (key == "head_c_offset_deg" && number && std::abs(*number) <= 360) head.c_offset_deg = *number;
+  else if (key == "head_rtcp" && node.value<bool>()) head.rtcp = *node.value<bool>();
+  else
+    throw std::runtime_error(fmt::format("{}: {} is not one of head_pivot_mm (>= 0), head_a_sign / head_c_sign (1 or -1), "
+                                         "head_c_offset_deg (-360 … 360), head_rtcp (true/false) with its value",
+                                         where(path, node), key));
+}
+
 }  // namespace
 
 void apply_machine_file(const std::string& path, SimOptions& options) {
@@ -76,10 +92,12 @@ void apply_machine_file(const std::string& path, SimOptions& options) {
     } else if (key == "jet_on_mcodes") m.parse.jet_on_mcodes = read_codes(path, key, node);
     else if (key == "jet_off_mcodes") m.parse.jet_off_mcodes = read_codes(path, key, node);
     else if (key == "pressure_ramp_s") options.plc.pressure_ramp_s = read_positive(path, key, node);
+    else if (key.starts_with("head_")) read_head(path, key, node, options.head ? *options.head : options.head.emplace());
     else
       throw std::runtime_error(fmt::format("{}: unknown key '{}' (known: soft_min soft_max g28_position soft_limits "
                                            "rapid_per_min max_feed_mm_per_min hold_decel_mm_per_s2 "
-                                           "planner_blocks rx_buffer jet_on_mcodes jet_off_mcodes pressure_ramp_s)",
+                                           "planner_blocks rx_buffer jet_on_mcodes jet_off_mcodes pressure_ramp_s "
+                                           "head_pivot_mm head_a_sign head_c_sign head_c_offset_deg head_rtcp)",
                                            where(path, node), key));
   }
   for (int i = 0; i < kAxisCount; ++i)

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "grbl_protocol.hpp"
+#include "jet_head.hpp"
 #include "machine.hpp"
 #include "plc.hpp"
 #include "xonxoff_protocol.hpp"
@@ -47,6 +48,9 @@ struct SimOptions {
   double time_scale = 1;
   OnOpen on_open = OnOpen::quiet;
   MachineConfig machine;
+  // The head (head_* keys of the machine file): with it, the execution log says where the jet's
+  // tip and axis are at the end of every block.
+  std::optional<HeadGeometry> head;
   GrblParams grbl;
   XonXoffParams xonxoff;
   PlcConfig plc;

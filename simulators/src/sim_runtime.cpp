@@ -63,7 +63,7 @@ SimRuntime::SimRuntime(SimOptions options)
       machine_(options_.machine),
       rx_pacer_(options_.baud / 10.0, kBurstS),
       tx_pacer_(options_.baud / 10.0, kBurstS),
-      log_(options_.log_path),
+      log_(options_.log_path, options_.head),
       plc_(options_.plc),
       garble_rng_(options_.faults.garble_seed) {
   if (!(options_.baud > 0)) throw std::runtime_error("--baud must be positive");
