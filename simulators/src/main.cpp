@@ -9,8 +9,11 @@
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include "coupon_reading.hpp"
 #include "sim_options.hpp"
 #include "sim_runtime.hpp"
+
+#include <fstream>
 
 namespace {
 
@@ -110,6 +113,37 @@ void apply_options(lamina::sim::SimOptions& o, const CliExtras& x) {
     throw std::runtime_error("--garble: a probability in [0, 1]");
 }
 
+// --measure-coupon: cut a calibration coupon's program on this machine (its head and jet from
+// --machine) and write what a person would measure; no ports, no waiting. docs/jet.md.
+struct MeasureOptions {
+  std::string program, out;
+  lamina::sim::ReadingParams reading;
+};
+
+void add_measure_options(CLI::App& app, MeasureOptions& m) {
+  app.add_option("--measure-coupon", m.program, "cut this coupon program (lamina calibrate coupon) and write its measurements, then exit");
+  app.add_option("--sheet-thickness", m.reading.sheet_thickness_mm, "the coupon sheet's thickness, mm (default 10)")->check(CLI::PositiveNumber);
+  app.add_option("--measure-out", m.out, "CSV of the measurements: label,top_width_mm,bottom_width_mm,trail_back_mm");
+  app.add_option("--measure-noise", m.reading.width_noise_mm, "the caliper's spread, mm (default 0.01)")->check(CLI::NonNegativeNumber);
+  app.add_option("--measure-seed", m.reading.seed, "seed of the measurement noise");
+}
+
+int measure_coupon(const lamina::sim::SimOptions& o, const MeasureOptions& m) {
+  using namespace lamina::sim;
+  std::ifstream in(m.program);
+  if (!in) throw std::runtime_error("--measure-coupon: cannot read " + m.program);
+  const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  auto readings = read_coupon(text, o.machine, o.head.value_or(HeadGeometry{}), o.jet, m.reading);
+  if (!readings) throw std::runtime_error(m.program + ": " + readings.error());
+  std::ofstream out(m.out.empty() ? "/dev/stdout" : m.out);
+  out << "label,top_width_mm,bottom_width_mm,trail_back_mm\n";
+  for (const CouponReading& r : *readings)
+    out << fmt::format("{},{:.4f},{:.4f},{:.4f}\n", r.label, r.top_width_mm, r.bottom_width_mm, r.trail_back_mm);
+  out.flush();
+  if (!out) throw std::runtime_error("--measure-out: cannot write " + m.out);
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -119,9 +153,12 @@ int main(int argc, char** argv) {
   CLI::App app{"lamina-sim: a simulated waterjet cell (CNC on a PTY/TCP, PLC on Modbus TCP)"};
   add_cell_options(app, o, x);
   add_fault_options(app, o, x);
+  MeasureOptions measure;
+  add_measure_options(app, measure);
   CLI11_PARSE(app, argc, argv);
   try {
     apply_options(o, x);
+    if (!measure.program.empty()) return measure_coupon(o, measure);
     std::signal(SIGTERM, on_signal);
     std::signal(SIGINT, on_signal);
     std::signal(SIGPIPE, SIG_IGN);

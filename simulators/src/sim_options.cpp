@@ -48,6 +48,29 @@ std::vector<int> read_codes(const std::string& path, const std::string& key, con
   return out;
 }
 
+// One jet_* key: the jet's physics, every coefficient a number > 0 (the taper's offset >= 0).
+void read_jet(const std::string& path, const std::string& key, const toml::node& node, JetPhysics& jet) {
+  const std::pair<std::string_view, double JetPhysics::*> keys[] = {
+      {"jet_separation_mm_per_s_at_10mm", &JetPhysics::separation_mm_per_s_at_10mm},
+      {"jet_separation_exponent", &JetPhysics::separation_exponent}, {"jet_focus_mm", &JetPhysics::focus_mm},
+      {"jet_slow_widening", &JetPhysics::slow_widening}, {"jet_slow_scale", &JetPhysics::slow_scale},
+      {"jet_taper_gain", &JetPhysics::taper_gain}, {"jet_taper_exponent", &JetPhysics::taper_exponent},
+      {"jet_taper_offset", &JetPhysics::taper_offset}, {"jet_lag_max_deg", &JetPhysics::lag_max_deg},
+      {"jet_lag_rate", &JetPhysics::lag_rate}};
+  for (const auto& [name, field] : keys) {
+    if (key != name) continue;
+    const auto v = node.value<double>();
+    const bool zero_ok = name == "jet_taper_offset";
+    if (!v || !std::isfinite(*v) || *v < 0 || (*v == 0 && !zero_ok))
+      throw std::runtime_error(fmt::format("{}: {} must be a number > 0{}", where(path, node), key, zero_ok ? " (or 0)" : ""));
+    jet.*field = *v;
+    return;
+  }
+  std::string known;
+  for (const auto& [name, field] : keys) known += std::string(known.empty() ? "" : " ") + std::string(name);
+  throw std::runtime_error(fmt::format("{}: unknown key '{}' (the jet's: {})", where(path, node), key, known));
+}
+
 // One head_* key into the head (made on the first of them; the others keep their defaults).
 void read_head(const std::string& path, const std::string& key, const toml::node& node, HeadGeometry& head) {
   const auto number = node.value<double>();
@@ -92,12 +115,13 @@ void apply_machine_file(const std::string& path, SimOptions& options) {
     } else if (key == "jet_on_mcodes") m.parse.jet_on_mcodes = read_codes(path, key, node);
     else if (key == "jet_off_mcodes") m.parse.jet_off_mcodes = read_codes(path, key, node);
     else if (key == "pressure_ramp_s") options.plc.pressure_ramp_s = read_positive(path, key, node);
+    else if (key.starts_with("jet_")) read_jet(path, key, node, options.jet);
     else if (key.starts_with("head_")) read_head(path, key, node, options.head ? *options.head : options.head.emplace());
     else
       throw std::runtime_error(fmt::format("{}: unknown key '{}' (known: soft_min soft_max g28_position soft_limits "
                                            "rapid_per_min max_feed_mm_per_min hold_decel_mm_per_s2 "
                                            "planner_blocks rx_buffer jet_on_mcodes jet_off_mcodes pressure_ramp_s "
-                                           "head_pivot_mm head_a_sign head_c_sign head_c_offset_deg head_rtcp)",
+                                           "head_pivot_mm head_a_sign head_c_sign head_c_offset_deg head_rtcp jet_*)",
                                            where(path, node), key));
   }
   for (int i = 0; i < kAxisCount; ++i)

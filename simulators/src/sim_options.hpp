@@ -6,6 +6,7 @@
 
 #include "grbl_protocol.hpp"
 #include "jet_head.hpp"
+#include "jet_physics.hpp"
 #include "machine.hpp"
 #include "plc.hpp"
 #include "xonxoff_protocol.hpp"
@@ -51,6 +52,7 @@ struct SimOptions {
   // The head (head_* keys of the machine file): with it, the execution log says where the jet's
   // tip and axis are at the end of every block.
   std::optional<HeadGeometry> head;
+  JetPhysics jet;  // jet_* keys: the kerf this machine's jet really leaves (--measure-coupon)
   GrblParams grbl;
   XonXoffParams xonxoff;
   PlcConfig plc;

@@ -13,6 +13,7 @@
 
 #include "exec_log.hpp"
 #include "jet_head.hpp"
+#include "jet_physics.hpp"
 #include "machine.hpp"
 #include "sim_options.hpp"
 
@@ -86,6 +87,24 @@ TEST(JetHead, ACouponLaminaPostedCutsWhereItSays) {
     y += 12;
   }
   std::filesystem::remove_all(dir);
+}
+
+// The simulated jet's own form: its taper reverses where k·r^n = k0, its trail-back saturates at
+// h·tan φ_max, its top widens when slow, and a jet past its separation speed does not cut through.
+TEST(JetPhysics, TheSimulatedJetsShape) {
+  const JetPhysics jet;  // v_s(10 mm) 25 mm/s
+  const double free_ratio = std::pow(jet.taper_offset / jet.taper_gain, 1.0 / jet.taper_exponent);
+  const CutWall balanced = cut_wall(jet, 10.0, free_ratio * 25.0);
+  EXPECT_NEAR(balanced.top_width_mm, balanced.bottom_width_mm, 1e-9);
+  const CutWall slow = cut_wall(jet, 10.0, 0.5 * free_ratio * 25.0), fast = cut_wall(jet, 10.0, 0.8 * 25.0);
+  EXPECT_GT(slow.bottom_width_mm, slow.top_width_mm) << "reversed";
+  EXPECT_LT(fast.bottom_width_mm, fast.top_width_mm) << "V";
+  EXPECT_GT(slow.top_width_mm, fast.top_width_mm) << "wider when slow";
+  EXPECT_LT(slow.trail_back_mm, fast.trail_back_mm);
+  EXPECT_NEAR(cut_wall(jet, 10.0, 100 * 25.0).trail_back_mm, 10.0 * std::tan(jet.lag_max_deg * kDeg), 1e-6) << "saturates";
+  EXPECT_EQ(cut_wall(jet, 10.0, 3 * 25.0).bottom_width_mm, 0.0) << "not through";
+  // A longer path is slower to separate: the same feed is a larger ratio there.
+  EXPECT_GT(cut_wall(jet, 20.0, 10.0).trail_back_mm, 2 * cut_wall(jet, 10.0, 10.0).trail_back_mm);
 }
 
 // The machine file's head_* keys give the head, and the execution log then says where the jet is.
