@@ -41,7 +41,14 @@ void print_fit(const KerfFit& fit, const std::string& material) {
   fmt::print("  trail-back   {:.4f}·h_f·r^{:.3f} mm\n\n", m.trail_back_factor, m.trail_back_exponent);
   fmt::print("{:<16} {:>10} {:>10} {:>10}   (measured - model, mm)\n", "cut", "top", "bottom", "trail");
   for (const KerfResidual& r : fit.residuals)
-    fmt::print("{:<16} {:>+10.4f} {:>+10.4f} {:>+10.4f}\n", r.label, r.top_width_mm, r.bottom_width_mm, r.trail_back_mm);
+    if (r.through)
+      fmt::print("{:<16} {:>+10.4f} {:>+10.4f} {:>+10.4f}\n", r.label, r.top_width_mm, r.bottom_width_mm, r.trail_back_mm);
+    else
+      fmt::print("{:<16} {:>+10.4f}   not through: only its top fitted\n", r.label, r.top_width_mm);
+  for (const KerfResidual& r : fit.residuals)
+    if (!r.through)
+      fmt::print("note: {} did not cut through: this machine's separation speed there is below the feed model's; "
+                 "slow the fastest cuts or check the material's machinability\n", r.label);
   fmt::print("rms: widths {:.4f} mm, trail-back {:.4f} mm\n", fit.rms_width_mm, fit.rms_trail_back_mm);
 }
 

@@ -66,9 +66,15 @@ std::expected<std::vector<CouponReading>, std::string> read_coupon(std::string_v
     const LongestCut& c = cuts[l];
     if (c.travel_mm <= 0.0) return std::unexpected(fmt::format("test cut {}: the jet never moved while on", l));
     const CutWall wall = cut_wall(jet, params.sheet_thickness_mm / c.axis_z, c.feed_mm_per_s);
-    // A caliper reads no less than nothing: a slot that did not cut through reads 0 at the bottom.
-    out.push_back({l, std::max(wall.top_width_mm + caliper(rng), 0.0), std::max(wall.bottom_width_mm + caliper(rng), 0.0),
-                   std::max(wall.trail_back_mm * (1.0 + gauge(rng)), 0.0)});
+    // A caliper reads no less than nothing. A slot that did not cut through has no bottom and no
+    // exit to read a trail-back from: both 0, as a person writes them.
+    CouponReading reading{l, std::max(wall.top_width_mm + caliper(rng), 0.0), 0.0, 0.0};
+    if (wall.bottom_width_mm > 0.0) {
+      reading.bottom_width_mm = std::max(wall.bottom_width_mm + caliper(rng), 0.0);
+      reading.trail_back_mm = std::max(wall.trail_back_mm * (1.0 + gauge(rng)), 0.0);
+    }
+    if (reading.bottom_width_mm == 0.0) reading.trail_back_mm = 0.0;
+    out.push_back(std::move(reading));
   }
   return out;
 }

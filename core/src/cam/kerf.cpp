@@ -24,8 +24,11 @@ std::expected<void, Error> check_cut(const KerfMeasurement& m, std::size_t row) 
   if (!positive(m.path_mm)) return std::unexpected(bad(fmt::format("{}: path {} mm must be > 0", name, m.path_mm)));
   if (!positive(m.feed_ratio))
     return std::unexpected(bad(fmt::format("{}: feed ratio {} must be > 0 (feed / separation feed)", name, m.feed_ratio)));
-  if (!positive(m.top_width_mm) || !positive(m.bottom_width_mm))
-    return std::unexpected(bad(fmt::format("{}: widths {} / {} mm must be > 0 (top / bottom)", name, m.top_width_mm, m.bottom_width_mm)));
+  const bool not_through = m.bottom_width_mm == 0.0;
+  if (!positive(m.top_width_mm) || (!positive(m.bottom_width_mm) && !not_through))
+    return std::unexpected(bad(fmt::format("{}: widths {} / {} mm must be > 0 (top / bottom; a bottom of 0: not through)", name,
+                                           m.top_width_mm, m.bottom_width_mm)));
+  if (not_through) return {};
   if (!positive(m.trail_back_mm))
     return std::unexpected(bad(fmt::format("{}: trail-back {} mm must be > 0 (a real cut always lags; 0 is a missing reading)",
                                            name, m.trail_back_mm)));
@@ -44,6 +47,29 @@ std::optional<std::pair<double, double>> line_fit(const Eigen::VectorXd& x, cons
 }
 
 double rms(const Eigen::VectorXd& v) { return v.size() ? std::sqrt(v.squaredNorm() / static_cast<double>(v.size())) : 0.0; }
+
+// Each cut's measured − model, and the RMS over what was measured (a cut that did not go through
+// has a top width only).
+void add_residuals(KerfFit& fit, std::span<const KerfMeasurement> cuts) {
+  std::vector<double> widths, lags;
+  const KerfModel& m = fit.model;
+  for (const KerfMeasurement& c : cuts) {
+    KerfResidual res{c.label, 0.0, 0.0, 0.0, c.bottom_width_mm != 0.0};
+    const double top_mm = m.top_width_mm + m.top_width_per_ratio_mm * c.feed_ratio;
+    res.top_width_mm = c.top_width_mm - top_mm;
+    widths.push_back(res.top_width_mm);
+    if (res.through) {
+      const double bottom_mm = top_mm - c.path_mm * m.taper_per_ratio * (c.feed_ratio - m.taper_free_ratio);
+      res.bottom_width_mm = c.bottom_width_mm - bottom_mm;
+      res.trail_back_mm = c.trail_back_mm - m.trail_back_factor * c.path_mm * std::pow(c.feed_ratio, m.trail_back_exponent);
+      widths.push_back(res.bottom_width_mm);
+      lags.push_back(res.trail_back_mm);
+    }
+    fit.residuals.push_back(std::move(res));
+  }
+  fit.rms_width_mm = rms(Eigen::Map<const Eigen::VectorXd>(widths.data(), static_cast<Eigen::Index>(widths.size())));
+  fit.rms_trail_back_mm = rms(Eigen::Map<const Eigen::VectorXd>(lags.data(), static_cast<Eigen::Index>(lags.size())));
+}
 
 }  // namespace
 
@@ -66,24 +92,31 @@ std::expected<KerfShape, Error> kerf_at(const KerfModel& model, double path_mm, 
 
 std::expected<KerfFit, Error> fit_kerf_model(std::span<const KerfMeasurement> cuts) {
   std::set<double> ratios;
+  std::vector<const KerfMeasurement*> through;
   for (std::size_t i = 0; i < cuts.size(); ++i) {
     if (auto ok = check_cut(cuts[i], i); !ok) return std::unexpected(ok.error());
+    if (cuts[i].bottom_width_mm == 0.0) continue;
     ratios.insert(cuts[i].feed_ratio);
+    through.push_back(&cuts[i]);
   }
   if (ratios.size() < 2)
-    return std::unexpected(bad(fmt::format("kerf fit: {} cut(s) at {} feed ratio(s); it needs cuts at two speeds at least",
-                                           cuts.size(), ratios.size())));
-  const auto n = static_cast<Eigen::Index>(cuts.size());
-  Eigen::VectorXd r(n), top(n), taper(n), log_r(n), log_lag(n);
+    return std::unexpected(bad(fmt::format("kerf fit: {} cut(s) through the sheet at {} feed ratio(s); it needs cuts at two "
+                                           "speeds at least",
+                                           through.size(), ratios.size())));
+  const auto n = static_cast<Eigen::Index>(cuts.size()), nt = static_cast<Eigen::Index>(through.size());
+  Eigen::VectorXd r(n), top(n), rt(nt), taper(nt), log_r(nt), log_lag(nt);
   for (Eigen::Index i = 0; i < n; ++i) {
-    const KerfMeasurement& c = cuts[static_cast<std::size_t>(i)];
-    r(i) = c.feed_ratio;
-    top(i) = c.top_width_mm;
+    r(i) = cuts[static_cast<std::size_t>(i)].feed_ratio;
+    top(i) = cuts[static_cast<std::size_t>(i)].top_width_mm;
+  }
+  for (Eigen::Index i = 0; i < nt; ++i) {
+    const KerfMeasurement& c = *through[static_cast<std::size_t>(i)];
+    rt(i) = c.feed_ratio;
     taper(i) = (c.top_width_mm - c.bottom_width_mm) / c.path_mm;
     log_r(i) = std::log(c.feed_ratio);
     log_lag(i) = std::log(c.trail_back_mm / c.path_mm);
   }
-  const auto width_line = line_fit(r, top), taper_line = line_fit(r, taper), lag_line = line_fit(log_r, log_lag);
+  const auto width_line = line_fit(r, top), taper_line = line_fit(rt, taper), lag_line = line_fit(log_r, log_lag);
   if (!width_line || !taper_line || !lag_line) return std::unexpected(bad("kerf fit: the feed ratios do not separate slope and intercept"));
   KerfFit fit;
   fit.model.top_width_mm = width_line->first;
@@ -96,20 +129,7 @@ std::expected<KerfFit, Error> fit_kerf_model(std::span<const KerfMeasurement> cu
   fit.model.trail_back_factor = std::exp(lag_line->first);
   fit.model.trail_back_exponent = lag_line->second;
 
-  Eigen::VectorXd width_error(2 * n), lag_error(n);
-  for (Eigen::Index i = 0; i < n; ++i) {
-    const KerfMeasurement& c = cuts[static_cast<std::size_t>(i)];
-    const KerfModel& m = fit.model;
-    const double top_mm = m.top_width_mm + m.top_width_per_ratio_mm * c.feed_ratio;
-    const double bottom_mm = top_mm - c.path_mm * m.taper_per_ratio * (c.feed_ratio - m.taper_free_ratio);
-    const double lag_mm = m.trail_back_factor * c.path_mm * std::pow(c.feed_ratio, m.trail_back_exponent);
-    fit.residuals.push_back({c.label, c.top_width_mm - top_mm, c.bottom_width_mm - bottom_mm, c.trail_back_mm - lag_mm});
-    width_error(2 * i) = fit.residuals.back().top_width_mm;
-    width_error(2 * i + 1) = fit.residuals.back().bottom_width_mm;
-    lag_error(i) = fit.residuals.back().trail_back_mm;
-  }
-  fit.rms_width_mm = rms(width_error);
-  fit.rms_trail_back_mm = rms(lag_error);
+  add_residuals(fit, cuts);
   return fit;
 }
 

@@ -112,6 +112,29 @@ TEST(KerfFit, ExactCutsGiveTheExactModel) {
   EXPECT_LT(fit->rms_width_mm, 1e-9);
 }
 
+// The fastest cuts on the longest path did not go through (the machine's separation speed is
+// below the feed model's): read as a bottom width of 0 and no trail-back, they still give their
+// top width, and the rest of the coupon gives the taper and the trail-back.
+TEST(KerfFit, ACutThatDidNotGoThroughFitsItsTopOnly) {
+  auto cuts = coupon(kModel, 4);
+  int dropped = 0;
+  for (KerfMeasurement& c : cuts)
+    if (c.path_mm == 20.0 && c.feed_ratio >= 0.75) c.bottom_width_mm = 0.0, c.trail_back_mm = 0.0, ++dropped;
+  ASSERT_EQ(dropped, 2);
+  auto fit = fit_kerf_model(cuts);
+  ASSERT_TRUE(fit) << fit.error().message;
+  EXPECT_NEAR(fit->model.taper_per_ratio, 0.05, 0.006);
+  EXPECT_NEAR(fit->model.trail_back_exponent, 1.8, 0.1);
+  EXPECT_NEAR(fit->model.top_width_mm, 0.95, 0.02);
+  int not_through = 0;
+  for (const KerfResidual& r : fit->residuals) {
+    not_through += !r.through;
+    if (!r.through) EXPECT_EQ(r.bottom_width_mm, 0.0) << "not measured, not a residual";
+  }
+  EXPECT_EQ(not_through, 2);
+  EXPECT_LT(fit->rms_width_mm, 0.02) << "the missing bottoms do not count as misfits";
+}
+
 TEST(KerfFit, MeasurementsThatCannotFitAreRefusedByName) {
   std::vector<KerfMeasurement> one_speed{{"a", 10, 0.5, 0.95, 0.9, 0.4}, {"b", 5, 0.5, 0.95, 0.92, 0.2}};
   auto r = fit_kerf_model(one_speed);

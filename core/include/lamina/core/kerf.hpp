@@ -56,6 +56,7 @@ struct KerfMeasurement {
 struct KerfResidual {
   std::string label;
   double top_width_mm = 0.0, bottom_width_mm = 0.0, trail_back_mm = 0.0;  // measured − model
+  bool through = true;  // false: the cut did not go through (bottom read 0); only its top was fitted
 };
 
 struct KerfFit {
@@ -64,9 +65,12 @@ struct KerfFit {
   double rms_width_mm = 0.0, rms_trail_back_mm = 0.0;
 };
 
-// Least squares over the measurements. Needs at least two distinct feed ratios, each measurement
-// with finite path, ratio > 0, widths > 0 and a trail-back > 0 (the lag of a real cut is never
-// zero; a zero is a missing reading); an error names the first bad row by its label.
+// Least squares over the measurements. Needs at least two distinct feed ratios among the cuts
+// that went through, each measurement with finite path, ratio > 0, a top width > 0, and a bottom
+// width and trail-back > 0 (the lag of a real cut is never zero; a zero is a missing reading) —
+// except a cut that did not go through, read as a bottom width of exactly 0: its top width is
+// fitted, its taper and trail-back are not (they were not there to measure). An error names the
+// first bad row by its label.
 std::expected<KerfFit, Error> fit_kerf_model(std::span<const KerfMeasurement> cuts);
 
 }  // namespace lamina
