@@ -472,6 +472,7 @@ class SheetBuilder {
       const double dur = jet_travel_s(a.tip, a.bottom, b.tip, b.bottom, f);
       if (dur <= 0.0) continue;  // a repeated line
       push(MoveKind::cut, b.tip, b.axis, f, dur, id);
+      out_.moves.back().tilt_limited = b.tilt_limited;
     }
     const double lead_out = fit_lead(p_.lead_out_mm, ring, end.tip.head<2>(), end.scrap);
     const Eigen::Vector2d out2 = end.tip.head<2>() + lead_out * end.scrap;

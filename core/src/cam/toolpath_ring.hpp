@@ -35,6 +35,7 @@ struct PathPoint {
   Eigen::Vector2d scrap = Eigen::Vector2d::Zero();   // unit, horizontal, away from the part
   double feed_mm_per_s = 0.0;                        // the feed model's at this line's tilt
   double corner_factor = 1.0;                        // slow-down at a sharp corner of the top path
+  bool tilt_limited = false;                         // jet compensation held at the head's tilt limit
 };
 
 // The lines of pass `pass` of `outline`, in cutting order (reversed when `reverse`), each moved by

@@ -223,6 +223,20 @@ void draw_part(std::string& svg, std::string& labels, int k, const BevelPlan& pl
                  k + 1, num(at.x()), num(at.y()), num(font), xml_escape(text));
 }
 
+// Where jet compensation met the head's tilt limit: each run of such cuts, over the toolpath.
+void draw_tilt_limited(std::string& svg, const SheetToolpath& tp) {
+  std::vector<Vec2> run;
+  for (std::size_t i = 1; i <= tp.moves.size(); ++i) {
+    const bool held = i < tp.moves.size() && tp.moves[i].tilt_limited;
+    if (held && run.empty()) run.push_back(tp.moves[i - 1].tip_mm.head<2>());
+    if (held) run.push_back(tp.moves[i].tip_mm.head<2>());
+    if (!held && !run.empty()) {
+      polyline(svg, "tilt-limited", run);
+      run.clear();
+    }
+  }
+}
+
 void draw_toolpath(std::string& svg, const SheetToolpath& tp, const Scale& s, bool rapids) {
   svg += "<g class=\"toolpath\">\n";
   if (rapids) {
@@ -236,6 +250,7 @@ void draw_toolpath(std::string& svg, const SheetToolpath& tp, const Scale& s, bo
     fmt::format_to(std::back_inserter(svg), "<line class=\"microjoint\" x1=\"{}\" y1=\"{}\" x2=\"{}\" y2=\"{}\"/>\n",
                    num(mj.from_mm.x()), num(mj.from_mm.y()), num(mj.to_mm.x()), num(mj.to_mm.y()));
   }
+  draw_tilt_limited(svg, tp);
   const double r = std::max(0.5, 2.0 * s.line);
   for (const auto& c : tp.contours) circle(svg, "pierce", c.pierce_mm, r);
   svg += "</g>\n";

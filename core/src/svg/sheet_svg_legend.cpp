@@ -58,6 +58,8 @@ std::string style_sheet(const Scale& s) {
   fmt::format_to(out, ".microjoint{{fill:none;stroke:#e377c2;stroke-width:{};stroke-linecap:round}}\n", num(3 * l));
   fmt::format_to(out, ".rapid{{fill:none;stroke:#7f7f7f;stroke-opacity:0.6;stroke-width:{};stroke-dasharray:{},{}}}\n",
                  num(l / 2), num(l), num(2 * l));
+  fmt::format_to(out, ".tilt-limited{{fill:none;stroke:#ffbf00;stroke-opacity:0.7;stroke-width:{};stroke-linecap:round}}\n",
+                 num(4 * l));
   fmt::format_to(out, ".label{{font-family:sans-serif;text-anchor:middle;fill:#000}}\n");
   fmt::format_to(out, ".legend-box{{fill:#fff;stroke:#000;stroke-width:{}}}\n", num(l / 2));
   fmt::format_to(out, ".legend{{font-family:sans-serif;font-size:{}px;fill:#000}}.legend-title{{font-weight:bold}}\n",

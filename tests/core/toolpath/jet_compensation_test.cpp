@@ -5,6 +5,7 @@
 #include "toolpath_fixture.hpp"
 
 #include <lamina/core/post.hpp>
+#include <lamina/core/sheet_svg.hpp>
 
 #include <gtest/gtest.h>
 
@@ -122,8 +123,18 @@ TEST(JetCompensation, TheTiltLimitHoldsTheLineAndIsCounted) {
   auto tp = plan_sheet_toolpath(f.plan, f.parts, f.sheet, aluminium(), p);
   ASSERT_TRUE(tp) << tp.error().message;
   EXPECT_GT(tp->jet_tilt_limited, 0u);
-  for (const ToolMove& m : tp->moves)
+  std::size_t marked = 0;
+  for (const ToolMove& m : tp->moves) {
     if (m.kind == MoveKind::cut) EXPECT_LE(std::acos(m.axis.z()), 0.002 + 1e-9);
+    marked += m.tilt_limited;
+  }
+  EXPECT_GT(marked, 0u);
+  // The sheet's drawing shows where: a highlighted run over those cuts, none without the limit.
+  const std::string svg = sheet_svg(f.plan, f.parts, f.sheet, *tp, SheetSvgParams{});
+  EXPECT_NE(svg.find("<polyline class=\"tilt-limited\""), std::string::npos);
+  auto free = plan_sheet_toolpath(f.plan, f.parts, f.sheet, aluminium(), with(JetCompensationMode::full));
+  ASSERT_TRUE(free);
+  EXPECT_EQ(sheet_svg(f.plan, f.parts, f.sheet, *free, SheetSvgParams{}).find("class=\"tilt-limited\""), std::string::npos);
 }
 
 TEST(JetCompensation, AMaterialWithoutCalibrationIsNamed) {

@@ -42,6 +42,7 @@ struct ToolMove {
   double dwell_s = 0.0;        // pierce only
   bool jet_on = false;         // the jet's state during the move (on from the pierce to the end of the lead-out)
   int contour = -1;            // index into SheetToolpath::contours; -1 for rapids between contours
+  bool tilt_limited = false;   // a cut whose jet compensation the head's tilt limit held back (drawn on the sheet)
 };
 
 // One cut from pierce to lead-out: a whole pass around an outline, or a run of it (a trim run,
