@@ -275,6 +275,7 @@ std::string sheet_svg(const BevelPlan& plan, std::span<const Part> parts, const 
   info.utilisation = sheet.utilisation;
   info.time_s = params.estimated_time_s > 0.0 ? params.estimated_time_s : toolpath.time.total_s;
   info.rapids = params.show_rapids;
+  info.tilt_limited = std::any_of(toolpath.moves.begin(), toolpath.moves.end(), [](const ToolMove& m) { return m.tilt_limited; });
   const Fragment leg = legend(info, s, L + gap, 0.0);
 
   const double doc_w = L + gap + leg.width + 2 * margin, doc_h = std::max(W, leg.height) + 2 * margin;

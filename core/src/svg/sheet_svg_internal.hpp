@@ -37,6 +37,7 @@ struct LegendInfo {
   double utilisation = 0.0;  // fraction
   double time_s = 0.0;
   bool rapids = true;
+  bool tilt_limited = false;  // some cut's jet compensation was held at the tilt limit
 };
 
 struct Fragment {

@@ -32,7 +32,15 @@ constexpr KeyEntry kKey[] = {
     {"microjoint", "Microjoint", Sample::mark},
     {"dowel", "Dowel hole", Sample::ring},
     {"rapid", "Rapid", Sample::line},
+    {"tilt-limited", "Held at the tilt limit (jet compensation)", Sample::line},
 };
+
+// A key row the sheet has nothing for is left out: rapids when not drawn, tilt-limited cuts
+// when there are none.
+bool shown(const KeyEntry& k, const LegendInfo& info) {
+  const std::string_view cls = k.cls;
+  return (cls != "rapid" || info.rapids) && (cls != "tilt-limited" || info.tilt_limited);
+}
 
 // Characters, not bytes: a rough width estimate for UTF-8 text.
 std::size_t glyphs(std::string_view s) {
@@ -81,9 +89,10 @@ Fragment legend(const LegendInfo& info, const Scale& s, double x, double y) {
 
   std::size_t widest = glyphs(info.title);
   for (const auto& t : facts) widest = std::max(widest, glyphs(t));
-  for (const auto& k : kKey) widest = std::max(widest, glyphs(k.label) + 5);
+  for (const auto& k : kKey)
+    if (shown(k, info)) widest = std::max(widest, glyphs(k.label) + 5);
   const double w = std::max(16.0 * f, 0.6 * f * static_cast<double>(widest) + 2 * pad);
-  const int key_rows = static_cast<int>(std::size(kKey)) - (info.rapids ? 0 : 1);
+  const int key_rows = static_cast<int>(std::count_if(std::begin(kKey), std::end(kKey), [&](const KeyEntry& k) { return shown(k, info); }));
   const int rows = (info.title.empty() ? 0 : 1) + static_cast<int>(facts.size()) + 1 + key_rows;
   const double h = rows * row + 2 * pad;
 
@@ -103,7 +112,7 @@ Fragment legend(const LegendInfo& info, const Scale& s, double x, double y) {
   }
   baseline += row;  // a blank row before the key
   for (const auto& k : kKey) {
-    if (!info.rapids && std::string_view(k.cls) == "rapid") continue;
+    if (!shown(k, info)) continue;
     const double cy = baseline - 0.35 * f;
     switch (k.sample) {
       case Sample::line:

@@ -132,9 +132,12 @@ TEST(JetCompensation, TheTiltLimitHoldsTheLineAndIsCounted) {
   // The sheet's drawing shows where: a highlighted run over those cuts, none without the limit.
   const std::string svg = sheet_svg(f.plan, f.parts, f.sheet, *tp, SheetSvgParams{});
   EXPECT_NE(svg.find("<polyline class=\"tilt-limited\""), std::string::npos);
+  EXPECT_NE(svg.find("Held at the tilt limit (jet compensation)"), std::string::npos) << "and the legend says what it is";
   auto free = plan_sheet_toolpath(f.plan, f.parts, f.sheet, aluminium(), with(JetCompensationMode::full));
   ASSERT_TRUE(free);
-  EXPECT_EQ(sheet_svg(f.plan, f.parts, f.sheet, *free, SheetSvgParams{}).find("class=\"tilt-limited\""), std::string::npos);
+  const std::string plain = sheet_svg(f.plan, f.parts, f.sheet, *free, SheetSvgParams{});
+  EXPECT_EQ(plain.find("class=\"tilt-limited\""), std::string::npos);
+  EXPECT_EQ(plain.find("Held at the tilt limit"), std::string::npos) << "no legend row for what is not there";
 }
 
 TEST(JetCompensation, AMaterialWithoutCalibrationIsNamed) {
