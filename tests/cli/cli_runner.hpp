@@ -44,4 +44,18 @@ inline fs::path temp_file(const std::string& name) {
 
 inline const fs::path kKnob = fs::path(LAMINA_EXAMPLES_DIR) / "knob.stl";
 
+// A folder of the test's own, gone afterwards. `made`: created empty now; otherwise only its
+// name, for a command that must create it (lamina plan --out).
+struct TempDir {
+  enum Make { name_only, made };
+  fs::path path;
+  explicit TempDir(const std::string& name, Make make = name_only) : path(temp_file(name)) {
+    fs::remove_all(path);
+    if (make == made) fs::create_directories(path);
+  }
+  ~TempDir() { fs::remove_all(path); }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+};
+
 }  // namespace lamina_cli_test

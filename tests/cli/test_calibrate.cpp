@@ -17,15 +17,6 @@ namespace {
 using namespace lamina_cli_test;
 using lamina::KerfModel;
 
-struct TempDir {
-  fs::path path;
-  explicit TempDir(const std::string& name) : path(temp_file(name)) {
-    fs::remove_all(path);
-    fs::create_directories(path);
-  }
-  ~TempDir() { fs::remove_all(path); }
-};
-
 const KerfModel kTruth{.top_width_mm = 0.92,
                        .top_width_per_ratio_mm = -0.05,
                        .taper_per_ratio = 0.06,
@@ -49,7 +40,7 @@ std::string coupon_csv(unsigned seed) {
 }
 
 TEST(CalibrateFit, RecoversTheKerfAndKeepsOtherMaterials) {
-  TempDir dir("calibrate-fit");
+  TempDir dir("calibrate-fit", TempDir::made);
   std::ofstream(dir.path / "al.csv") << coupon_csv(7);
   std::ofstream(dir.path / "steel.csv") << coupon_csv(8);
   const std::string kerf = quoted(dir.path / "kerf.toml");
@@ -88,7 +79,7 @@ TEST(CalibrateFit, RecoversTheKerfAndKeepsOtherMaterials) {
 }
 
 TEST(CalibrateFit, ABrokenMeasurementFileIsNamedByLineAndNothingIsWritten) {
-  TempDir dir("calibrate-bad");
+  TempDir dir("calibrate-bad", TempDir::made);
   const std::string header = "label,path_mm,feed_ratio,top_width_mm,bottom_width_mm,trail_back_mm\n";
   const std::vector<std::pair<std::string, std::string>> cases{
       {header + "a,10,0.5,0.9,0.85,0.3\nb,10,0.8,0.9,abc,0.5\n", "m.csv:3: bottom_width_mm: 'abc' is not a number"},
@@ -120,7 +111,7 @@ TEST(CalibrateFit, ABrokenMeasurementFileIsNamedByLineAndNothingIsWritten) {
 // The loop a shop runs: the coupon's program and its CSV, the cuts "measured" (here: the truth
 // plus a caliper's noise, at the paths and ratios the CSV lists), the fit.
 TEST(CalibrateCoupon, ItsSheetFilledInFitsBackTheKerf) {
-  TempDir dir("calibrate-coupon");
+  TempDir dir("calibrate-coupon", TempDir::made);
   auto r = lamina_cli_test::lamina("calibrate coupon --material 'aluminium 6061-T6' --thickness 10 --out " + quoted(dir.path));
   ASSERT_EQ(r.exit_code, 0) << r.out;
   ASSERT_TRUE(fs::exists(dir.path / "coupon.nc"));
@@ -177,7 +168,7 @@ std::string read_text(const fs::path& p) {
 // uncalibrated shop keep today's programs byte for byte, and asking for compensation without a
 // calibration is an error that says what to do.
 TEST(PlanJetCompensation, ACalibratedMaterialIsCompensatedAndOffChangesNothing) {
-  TempDir dir("plan-jet");
+  TempDir dir("plan-jet", TempDir::made);
   std::ofstream(dir.path / "kerf.toml") << lamina::cli::kerf_toml({{"aluminium 6061-T6", {kTruth, 10, 0.01, 0.02, "al.csv"}}});
   const std::string knob = quoted(fs::path(LAMINA_EXAMPLES_DIR) / "knob.stl") + " --stock 5";
   const auto plan = [&](const std::string& name, const std::string& extra) {

@@ -29,12 +29,6 @@ json read_json(const fs::path& p) {
 bool has_text(const CliRun& r, const std::string& s) { return r.out.find(s) != std::string::npos; }
 
 // A fresh, empty folder for one test's outputs; removed when the test ends.
-struct TempDir {
-  fs::path path;
-  explicit TempDir(const std::string& name) : path(temp_file(name)) { fs::remove_all(path); }
-  ~TempDir() { fs::remove_all(path); }
-};
-
 // Every key the issue and docs/planning.md promise, and the invariants between them.
 void expect_report_is_complete(const json& j, const std::set<double>& stock, double bond) {
   for (const char* k : {"model", "settings", "layers", "stack", "shortfalls", "deviation", "warnings", "timing_s"})

@@ -19,15 +19,6 @@ namespace {
 using namespace lamina_cli_test;
 using nlohmann::json;
 
-struct TempDir {
-  fs::path path;
-  explicit TempDir(const std::string& name) : path(temp_file(name)) {
-    fs::remove_all(path);
-    fs::create_directories(path);
-  }
-  ~TempDir() { fs::remove_all(path); }
-};
-
 // A truncated cone, r 40 at z 0 to r 20 at z 20 (45°: bevels follow it exactly, so thick sheets
 // are the layering's first choice), as ASCII STL.
 std::string cone_stl() {
@@ -66,7 +57,7 @@ json read_report(const fs::path& dir) {
 }
 
 TEST(CliPlanRack, ThePlanFitsTheRacksCounts) {
-  TempDir dir("plan-rack");
+  TempDir dir("plan-rack", TempDir::made);
   std::ofstream(dir.path / "cone.stl") << cone_stl();
   // One Ø80 layer (Ø81 with the kerf) per 110 mm sheet: the rack holds one 5 mm layer, the cone alone would take four.
   std::ofstream(dir.path / "rack.toml") << sheet(1.0, 400, 2) + sheet(2.5, 400, 2) + sheet(5.0, 110, 1);
@@ -90,7 +81,7 @@ TEST(CliPlanRack, ThePlanFitsTheRacksCounts) {
 }
 
 TEST(CliPlanRack, ARackThatCannotMakeTheStackSaysWhichThicknessRunsOut) {
-  TempDir dir("plan-rack-short");
+  TempDir dir("plan-rack-short", TempDir::made);
   std::ofstream(dir.path / "cone.stl") << cone_stl();
   // 5 mm sheets only, two of them holding one layer each: 10 mm of the cone's 20.
   std::ofstream(dir.path / "rack.toml") << sheet(5.0, 110, 2);
@@ -112,7 +103,7 @@ TEST(CliPlanRack, ARackThatCannotMakeTheStackSaysWhichThicknessRunsOut) {
 // Where each sheet lies on the rack (issue 19: the operator's prompt names the slot): a stock
 // entry's `slot` goes to every sheet cut from it, in the report and the sheet table.
 TEST(CliPlanRack, EverySheetSaysWhichRackSlotItComesFrom) {
-  TempDir dir("plan-rack-slots");
+  TempDir dir("plan-rack-slots", TempDir::made);
   std::ofstream(dir.path / "cone.stl") << cone_stl();
   // One 5 mm sheet that holds one layer (as above): the rest of the cone comes from the 2.5 mm entry.
   std::ofstream(dir.path / "rack.toml") << sheet(2.5, 400, 4) + "slot = \"R2 left\"\n" + sheet(5.0, 110, 1) + "slot = \"R7\"\n";
@@ -139,7 +130,7 @@ TEST(CliPlanRack, EverySheetSaysWhichRackSlotItComesFrom) {
 }
 
 TEST(CliPlanRack, ASlotThatIsNoLabelIsRefusedWithItsLine) {
-  TempDir dir("plan-rack-bad-slot");
+  TempDir dir("plan-rack-bad-slot", TempDir::made);
   std::ofstream(dir.path / "cone.stl") << cone_stl();
   for (const std::string& bad : {std::string("slot = \"\""), std::string("slot = 3"), std::string("slot = \"") + std::string(41, 'x') + "\"",
                                  std::string("slot = \"R1\\u0007\"")}) {

@@ -20,12 +20,6 @@ using nlohmann::json;
 
 const fs::path kConfig = fs::path(LAMINA_EXAMPLES_DIR).parent_path() / "config";
 
-struct TempDir {
-  fs::path path;
-  explicit TempDir(const std::string& name) : path(temp_file(name)) { fs::remove_all(path); }
-  ~TempDir() { fs::remove_all(path); }
-};
-
 std::string slurp(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);
   std::ostringstream s;

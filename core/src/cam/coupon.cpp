@@ -4,6 +4,8 @@
 // way a bevel does, so the slot crosses a path of t / cos tilt.
 #include "lamina/core/coupon.hpp"
 
+#include "cam/toolpath_ring.hpp"
+
 #include <fmt/format.h>
 
 #include <cmath>
@@ -29,14 +31,14 @@ std::expected<void, Error> check(const CouponParams& c) {
   return {};
 }
 
-// The jet's travel time between two tips with their axes: the longer of the top's and the bottom's.
+// The jet's travel time between two tips with their axes (the toolpath's rule: top or bottom,
+// whichever moves further).
 double travel_s(const Eigen::Vector3d& tip0, const Eigen::Vector3d& axis0, const Eigen::Vector3d& tip1,
                 const Eigen::Vector3d& axis1, double thickness_mm, double feed_mm_per_s) {
   const auto bottom = [&](const Eigen::Vector3d& tip, const Eigen::Vector3d& axis) -> Eigen::Vector3d {
     return tip - axis * (thickness_mm / axis.z());
   };
-  const double top = (tip1 - tip0).norm(), low = (bottom(tip1, axis1) - bottom(tip0, axis0)).norm();
-  return std::max(top, low) / feed_mm_per_s;
+  return cam_detail::jet_travel_s(tip0, bottom(tip0, axis0), tip1, bottom(tip1, axis1), feed_mm_per_s);
 }
 
 class CouponBuilder {

@@ -64,11 +64,6 @@ std::expected<void, Error> check_params(const ToolpathParams& p) {
   return {};
 }
 
-double jet_travel_s(const Eigen::Vector3d& top0, const Eigen::Vector3d& bottom0, const Eigen::Vector3d& top1,
-                    const Eigen::Vector3d& bottom1, double feed_mm_per_s) {
-  return std::max((top1 - top0).norm(), (bottom1 - bottom0).norm()) / feed_mm_per_s;
-}
-
 // What a contour is (ToolContour::frees / closed): a whole freeing ring, a run of a trim pass
 // (where a multi-cut edge differs from the last pass), or a run between microjoints.
 struct ContourShape {
@@ -464,12 +459,12 @@ class SheetBuilder {
     push(MoveKind::pierce, pierce, Eigen::Vector3d::UnitZ(), 0.0, p_.pierce_dwell_s, id, p_.pierce_dwell_s);
     // Lead-in: the head turns from vertical (the pierce) to the first line's axis on the way.
     const double f_in = first.feed_mm_per_s * first.corner_factor;
-    push(MoveKind::lead_in, first.tip, first.axis, f_in, jet_travel_s(pierce, pierce - down, first.tip, first.bottom, f_in), id);
+    push(MoveKind::lead_in, first.tip, first.axis, f_in, cam_detail::jet_travel_s(pierce, pierce - down, first.tip, first.bottom, f_in), id);
     for (std::size_t k = 1; k < pts.size(); ++k) {
       const PathPoint& a = pts[k - 1];
       const PathPoint& b = pts[k];
       const double f = std::min(a.feed_mm_per_s, b.feed_mm_per_s) * std::min(a.corner_factor, b.corner_factor);
-      const double dur = jet_travel_s(a.tip, a.bottom, b.tip, b.bottom, f);
+      const double dur = cam_detail::jet_travel_s(a.tip, a.bottom, b.tip, b.bottom, f);
       if (dur <= 0.0) continue;  // a repeated line
       push(MoveKind::cut, b.tip, b.axis, f, dur, id);
       out_.moves.back().tilt_limited = b.tilt_limited;
@@ -480,7 +475,7 @@ class SheetBuilder {
     const Eigen::Vector3d out_bottom = out - (t_mm / end.axis.z()) * end.axis;
     const double f_out = end.feed_mm_per_s * end.corner_factor;
     if (lead_out > 0.0)
-      push(MoveKind::lead_out, out, end.axis, f_out, jet_travel_s(end.tip, end.bottom, out, out_bottom, f_out), id);
+      push(MoveKind::lead_out, out, end.axis, f_out, cam_detail::jet_travel_s(end.tip, end.bottom, out, out_bottom, f_out), id);
     rapid_to({out.x(), out.y(), p_.safe_z_mm}, end.axis, id);
     c.end_move = out_.moves.size();
     out_.contours.push_back(c);

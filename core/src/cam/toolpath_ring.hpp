@@ -6,6 +6,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include <algorithm>
 #include <vector>
 
 namespace lamina::cam_detail {
@@ -37,6 +38,13 @@ struct PathPoint {
   double corner_factor = 1.0;                        // slow-down at a sharp corner of the top path
   bool tilt_limited = false;                         // jet compensation held at the head's tilt limit
 };
+
+// How long the jet takes from one line to the next: the longer of the top's and the bottom's
+// travel at the feed (a move that only turns the head about its tip still moves its bottom).
+inline double jet_travel_s(const Eigen::Vector3d& top0, const Eigen::Vector3d& bottom0, const Eigen::Vector3d& top1,
+                           const Eigen::Vector3d& bottom1, double feed_mm_per_s) {
+  return std::max((top1 - top0).norm(), (bottom1 - bottom0).norm()) / feed_mm_per_s;
+}
 
 // The lines of pass `pass` of `outline`, in cutting order (reversed when `reverse`), each moved by
 // half the kerf towards the scrap along the ruled surface's normal — the normals of the two faces
