@@ -1,5 +1,6 @@
 // lamina plan MODEL --out DIR: the edge of plan_job (lamina/core/plan_job.hpp): options and files
 // in, DIR/stack.stl, the sheets' programs and drawings and DIR/report.json out, tables printed.
+#include "as_cut_files.hpp"
 #include "commands.hpp"
 #include "plan_cam.hpp"
 #include "plan_output.hpp"
@@ -79,6 +80,19 @@ int write_plan(const PlanOptions& o, PlanJobResult& r, PlanProgress& progress, C
   return 0;
 }
 
+// --as-cut: the sheets as the machine cut them, measured against the model beside the plan.
+int add_as_cut(const std::string& dir, const Mesh& mesh, PlanJobResult& r) {
+  if (!r.cam) return report_error({ErrorCode::invalid_argument, "--as-cut needs the sheets' programs (leave out --no-programs)"}, 2);
+  auto cut = read_cut_sheets(dir, *r.cam);
+  if (!cut) return report_error(cut.error());
+  std::vector<NestedSheet> sheets;
+  for (const SheetOutput& s : r.cam->sheets) sheets.push_back(s.sheet);
+  auto d = measure_as_cut(mesh, r.plan, r.cam->parts, sheets, *cut, AsCutParams{});
+  if (!d) return report_error(d.error());
+  r.report.as_cut = report_as_cut(*d, dir);
+  return 0;
+}
+
 void print_plan(const PlanOptions& o, const PlanJobResult& r) {
   if (o.json) {
     fmt::print("{}", plan_report_json(r.report));
@@ -87,6 +101,10 @@ void print_plan(const PlanOptions& o, const PlanJobResult& r) {
     print_plan_tables(stdout, r.report, o.all_rows);
     fmt::print("\n");
     print_sheet_table(stdout, r.report);
+    if (r.report.as_cut) {
+      fmt::print("\n");
+      print_as_cut_table(stdout, *r.report.as_cut, o.all_rows);
+    }
     fmt::print("wrote {} ({} bytes), {}", (dir / "stack.stl").string(), r.stack_stl.size(), (dir / "report.json").string());
     if (r.cam && !r.cam->sheets.empty())
       fmt::print(", and {} program(s) + drawing(s) {}/sheet-<n>.nc, .svg", r.cam->sheets.size(), dir.string());
@@ -129,6 +147,8 @@ int run_plan(const PlanOptions& o, const CamOptions& cam_options) {
       progress.within(plan_phase_name(step.phase), step.done, step.total);
   });
   if (!r) return report_error(r.error().error, exit_code_of(r.error()));
+  if (!o.as_cut_dir.empty())
+    if (int code = add_as_cut(o.as_cut_dir, mesh, *r)) return code;
   if (int code = write_plan(o, *r, progress, t_start)) return code;
   print_plan(o, *r);
   return 0;

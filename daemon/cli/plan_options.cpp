@@ -99,6 +99,9 @@ void add_plan_options(CLI::App& cmd, PlanOptions& o) {
   cmd.add_option("--progress-fd", o.progress_fd, "Write one JSON line per planning phase to this open file descriptor")
       ->check(CLI::NonNegativeNumber);
   cmd.add_flag("--all-rows", o.all_rows, "Print every layer in the table");
+  cmd.add_option("--as-cut", o.as_cut_dir,
+                 "Folder of the sheets as cut (sheet-<n>.ascut.json from lamina-sim --as-cut): measure the part as cut "
+                 "beside the plan (report.json's as_cut)");
   cmd.footer(
       "All plan lengths (--stock, --bond, --sub-slice, --tolerance, --deviation-step) are in mm and\n"
       "--tilt-max in degrees, whatever --units says: --units is the unit of the model file only.\n"

@@ -34,6 +34,7 @@ struct PlanOptions {
   bool json = false;
   bool all_rows = false;
   int progress_fd = -1;                   // --progress-fd: phase lines for laminad (plan_progress.hpp)
+  std::string as_cut_dir;                 // --as-cut: the sheets as cut (sheet-<n>.ascut.json), measured beside the plan
 };
 
 // Validated, in core units: PlanSettings (lamina/core/plan_job.hpp).

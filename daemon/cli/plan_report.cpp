@@ -64,4 +64,23 @@ void print_plan_tables(std::FILE* out, const PlanReport& report, bool all_rows) 
              t.read, t.topology, t.layering, t.bevel, t.deviation, t.write, t.total);
 }
 
+void print_as_cut_table(std::FILE* out, const ReportAsCut& a, bool all_rows) {
+  fmt::print(out, "{:>5} {:>12} {:>12} {:>10} {:>10} {:>6}\n", "layer", "planned %", "as cut %", "planned mm", "as cut mm", "parts");
+  const std::size_t n = a.layers.size();
+  const bool elide = !all_rows && n > 40;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (elide && i == 20) fmt::print(out, "{:>5}   ({} more layers: --all-rows or report.json)\n", "...", n - 25);
+    if (elide && i >= 20 && i < n - 5) continue;
+    const ReportAsCutLayer& l = a.layers[i];
+    fmt::print(out, "{:>5} {:>12.3f} {:>12.3f} {:>10.3f} {:>10.3f} {:>6}\n", l.layer, l.planned.volume_pct, l.as_cut.volume_pct,
+               l.planned.max_mm, l.as_cut.max_mm, l.parts_freed == l.parts ? fmt::format("{}", l.parts) : fmt::format("{}/{}", l.parts_freed, l.parts));
+  }
+  fmt::print(out, "{:>5} {:>12.3f} {:>12.3f} {:>10.3f} {:>10.3f} {:>6}\n", "all", a.planned.volume_pct, a.as_cut.volume_pct,
+             a.planned.max_mm, a.as_cut.max_mm, a.parts_freed == a.parts ? fmt::format("{}", a.parts) : fmt::format("{}/{}", a.parts_freed, a.parts));
+  fmt::print(out, "  as cut ({}) beside the plan, both in the same slabs: % of the model's {:.6g} mm3 there;\n"
+                  "  mm: largest distance from the cut wall to the model; parts: freed (of placed)\n",
+             a.dir, a.model_volume_mm3);
+  for (const std::string& s : a.not_freed) fmt::print(out, "  not freed: {}\n", s);
+}
+
 }  // namespace lamina::cli

@@ -1,5 +1,7 @@
 #include "coupon_reading.hpp"
 
+#include "program_run.hpp"
+
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -29,36 +31,25 @@ struct LongestCut {
 std::expected<std::vector<CouponReading>, std::string> read_coupon(std::string_view program, MachineConfig machine,
                                                                    const HeadGeometry& head, const JetPhysics& jet,
                                                                    const ReadingParams& params) {
-  machine.planner_blocks = 1u << 20;
-  Machine m(machine);
   std::vector<std::string> order;
   std::map<std::string, LongestCut> cuts;
   std::string label;
-  double now_s = 0.0;
-  std::size_t line_no = 0;
-  for (std::size_t start = 0; start < program.size();) {
-    const std::size_t nl = program.find('\n', start);
-    const std::string_view line = program.substr(start, nl == std::string_view::npos ? std::string_view::npos : nl - start);
-    start = nl == std::string_view::npos ? program.size() : nl + 1;
-    ++line_no;
+  ProgramCallbacks callbacks;
+  callbacks.on_line = [&](std::string_view line) {
     if (auto l = test_cut_label(line); !l.empty()) {
       label = l;
       if (!cuts.contains(label)) order.push_back(label);
       cuts[label];
     }
-    if (m.submit_line(line, now_s) != GrblStatus::ok)
-      return std::unexpected(fmt::format("line {}: the controller refused '{}'", line_no, line));
-    now_s += 1e4;  // every block finishes before the next line: each belongs to the marker before it
-    m.advance(now_s);
-    for (const auto& event : m.take_events()) {
-      const auto* b = std::get_if<ExecutedBlock>(&event);
-      if (!b || !b->jet || label.empty() || b->t_end_s <= b->t_start_s) continue;
-      const JetPose from = jet_pose(b->start, head), to = jet_pose(b->end, head);
-      const double travel = std::hypot(to.tip_mm[0] - from.tip_mm[0], to.tip_mm[1] - from.tip_mm[1], to.tip_mm[2] - from.tip_mm[2]);
-      LongestCut& c = cuts[label];
-      if (travel > c.travel_mm) c = {travel, travel / (b->t_end_s - b->t_start_s), to.axis[2]};
-    }
-  }
+  };
+  callbacks.on_block = [&](const ExecutedBlock& b) {
+    if (!b.jet || label.empty() || b.t_end_s <= b.t_start_s) return;
+    const JetPose from = jet_pose(b.start, head), to = jet_pose(b.end, head);
+    const double travel = std::hypot(to.tip_mm[0] - from.tip_mm[0], to.tip_mm[1] - from.tip_mm[1], to.tip_mm[2] - from.tip_mm[2]);
+    LongestCut& c = cuts[label];
+    if (travel > c.travel_mm) c = {travel, travel / (b.t_end_s - b.t_start_s), to.axis[2]};
+  };
+  if (auto ran = run_program(program, std::move(machine), callbacks); !ran) return std::unexpected(ran.error());
   std::mt19937_64 rng(params.seed);
   std::normal_distribution<double> caliper(0.0, params.width_noise_mm), gauge(0.0, params.trail_back_noise);
   std::vector<CouponReading> out;

@@ -28,6 +28,9 @@ struct JetPhysics {
 
 struct CutWall {
   double top_width_mm = 0.0, bottom_width_mm = 0.0, trail_back_mm = 0.0;
+  // tan θ of each wall from the jet's axis, as the physics gives it: where the walls would meet
+  // above the bottom (w_t / (2 tan θ) < the path), the jet stops there and bottom_width_mm is 0.
+  double wall_lean_tan = 0.0;
 };
 
 // The kerf of a straight cut crossing `path_mm` of material at `feed_mm_per_s`.

@@ -9,10 +9,12 @@
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include "as_cut.hpp"
 #include "coupon_reading.hpp"
 #include "sim_options.hpp"
 #include "sim_runtime.hpp"
 
+#include <filesystem>
 #include <fstream>
 
 namespace {
@@ -118,6 +120,9 @@ void apply_options(lamina::sim::SimOptions& o, const CliExtras& x) {
 struct MeasureOptions {
   std::string program, out;
   lamina::sim::ReadingParams reading;
+  // --as-cut: cut a sheet's program and write what the jet cut out of it (as_cut.hpp)
+  std::string as_cut_program, as_cut_out;
+  int as_cut_sections = 8;
 };
 
 void add_measure_options(CLI::App& app, MeasureOptions& m) {
@@ -126,13 +131,44 @@ void add_measure_options(CLI::App& app, MeasureOptions& m) {
   app.add_option("--measure-out", m.out, "CSV of the measurements: label,top_width_mm,bottom_width_mm,trail_back_mm");
   app.add_option("--measure-noise", m.reading.width_noise_mm, "the caliper's spread, mm (default 0.01)")->check(CLI::NonNegativeNumber);
   app.add_option("--measure-seed", m.reading.seed, "seed of the measurement noise");
+  app.add_option("--as-cut", m.as_cut_program, "cut this sheet program with this machine's jet and write the pieces it cut out, then exit");
+  app.add_option("--as-cut-out", m.as_cut_out, "the as-cut sections (JSON; default: stdout)");
+  app.add_option("--as-cut-sections", m.as_cut_sections, "depths the pieces are sectioned at (default 8)")->check(CLI::Range(1, 1000));
+}
+
+std::string read_program(const std::string& path, const char* option) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error(fmt::format("{}: cannot read {}", option, path));
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+int write_as_cut(const lamina::sim::SimOptions& o, const MeasureOptions& m) {
+  using namespace lamina::sim;
+  const std::string text = read_program(m.as_cut_program, "--as-cut");
+  AsCutParams params;
+  params.sheet_thickness_mm = m.reading.sheet_thickness_mm;
+  params.sections = m.as_cut_sections;
+  auto cut = cut_program(text, o.machine, o.head.value_or(HeadGeometry{}), o.jet, params);
+  if (!cut) throw std::runtime_error(m.as_cut_program + ": " + cut.error());
+  const std::string name = std::filesystem::path(m.as_cut_program).filename().string();
+  const std::string json = as_cut_json(*cut, name, text).dump();
+  if (m.as_cut_out.empty()) {
+    std::fwrite(json.data(), 1, json.size(), stdout);
+    return 0;
+  }
+  // Written whole and renamed: a reader never sees half a file.
+  const std::string partial = m.as_cut_out + ".partial";
+  std::ofstream out(partial, std::ios::binary | std::ios::trunc);
+  out << json;
+  out.close();
+  if (!out) throw std::runtime_error("--as-cut-out: cannot write " + partial);
+  std::filesystem::rename(partial, m.as_cut_out);
+  return 0;
 }
 
 int measure_coupon(const lamina::sim::SimOptions& o, const MeasureOptions& m) {
   using namespace lamina::sim;
-  std::ifstream in(m.program);
-  if (!in) throw std::runtime_error("--measure-coupon: cannot read " + m.program);
-  const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  const std::string text = read_program(m.program, "--measure-coupon");
   auto readings = read_coupon(text, o.machine, o.head.value_or(HeadGeometry{}), o.jet, m.reading);
   if (!readings) throw std::runtime_error(m.program + ": " + readings.error());
   std::ofstream out(m.out.empty() ? "/dev/stdout" : m.out);
@@ -159,6 +195,7 @@ int main(int argc, char** argv) {
   try {
     apply_options(o, x);
     if (!measure.program.empty()) return measure_coupon(o, measure);
+    if (!measure.as_cut_program.empty()) return write_as_cut(o, measure);
     std::signal(SIGTERM, on_signal);
     std::signal(SIGINT, on_signal);
     std::signal(SIGPIPE, SIG_IGN);

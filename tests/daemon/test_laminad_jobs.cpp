@@ -167,15 +167,16 @@ TEST(LaminadJobs, AControllerThatStallsWithTheJetOnIsStoppedAtOnceAndResumed) {
   const std::string id = cut_sheet_one_of_the_knob(c, cell, daemon, 10);
   ASSERT_FALSE(id.empty());
   const auto lines = program_lines(call_ok(c, "job.get", {{"job", id}})["sheets"][0]["program"]);
-  const std::size_t contour = long_contour(lines, 300, 60);
-  ASSERT_GT(contour, 0u) << "no contour of 60 cuts in the knob's first sheet";
+  // Well inside the contour's cut, past its lead-in (which turns the head in pieces of 2°: up to 30 lines).
+  const std::size_t contour = long_contour(lines, 300, 100);
+  ASSERT_GT(contour, 0u) << "no contour of 100 cuts in the knob's first sheet";
   const int port = cell.sim.control_port();
   const auto executed_past = [&](std::size_t n) {
     return sim::testing::wait_status(port, [n](const Json& s) { return s["executed_blocks"].get<std::size_t>() > n; }, 60);
   };
   ASSERT_TRUE(executed_past(contour - 40));
   EXPECT_EQ(sim::testing::control(port, "time-scale 1").substr(0, 2), "ok");
-  ASSERT_TRUE(executed_past(contour + 10));
+  ASSERT_TRUE(executed_past(contour + 50));
   EXPECT_EQ(sim::testing::control(port, "stall 3000").substr(0, 2), "ok");
   const Json paused = wait_job(c, id, [](const Json& j) { return j["state"] != "cutting"; }, 30);
   ASSERT_EQ(paused["state"], "paused") << paused.dump(2) << daemon.log();

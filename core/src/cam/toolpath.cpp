@@ -53,6 +53,8 @@ std::expected<void, Error> check_params(const ToolpathParams& p) {
     return std::unexpected(invalid(fmt::format("safe height {} mm must be > 0", p.safe_z_mm)));
   if (!(p.rapid_mm_per_s > 0.0) || !std::isfinite(p.rapid_mm_per_s))
     return std::unexpected(invalid(fmt::format("rapid rate {} mm/s must be > 0", p.rapid_mm_per_s)));
+  if (!(p.max_turn_per_move_rad > 0.0) || !std::isfinite(p.max_turn_per_move_rad))
+    return std::unexpected(invalid(fmt::format("largest turn per move {} rad must be > 0", p.max_turn_per_move_rad)));
   if (p.microjoints < 0 || p.microjoints > 100)
     return std::unexpected(invalid(fmt::format("microjoints {} must be 0 … 100", p.microjoints)));
   if (!(p.microjoint_width_mm > 0.0) || !std::isfinite(p.microjoint_width_mm))
@@ -408,8 +410,28 @@ class SheetBuilder {
   }
 
   // The jet is on for every move but a rapid (the pierce opens it, the lead-out closes the cut).
+  // A move whose axis turns more than max_turn_per_move_rad from the last one goes out in pieces
+  // (ToolpathParams::max_turn_per_move_rad: a pivot head's tip would leave its line).
   void push(MoveKind kind, const Eigen::Vector3d& tip, const Eigen::Vector3d& axis, double feed, double duration,
             int contour, double dwell = 0.0) {
+    if (!out_.moves.empty()) {
+      const Eigen::Vector3d from_tip = out_.moves.back().tip_mm, from_axis = out_.moves.back().axis;
+      const double turn = std::acos(std::clamp(from_axis.dot(axis), -1.0, 1.0));
+      const auto pieces = static_cast<int>(std::ceil(turn / p_.max_turn_per_move_rad - 1e-9));
+      for (int i = 1; i < pieces; ++i) {
+        const double f = static_cast<double>(i) / pieces;
+        const Eigen::Vector3d between =
+            (std::sin((1.0 - f) * turn) * from_axis + std::sin(f * turn) * axis) / std::sin(turn);
+        append(kind, from_tip + (tip - from_tip) * f, between.normalized(), feed, duration / pieces, contour, 0.0);
+        out_.moves.back().turn_piece = true;
+      }
+      if (pieces > 1) duration /= pieces;
+    }
+    append(kind, tip, axis, feed, duration, contour, dwell);
+  }
+
+  void append(MoveKind kind, const Eigen::Vector3d& tip, const Eigen::Vector3d& axis, double feed, double duration,
+              int contour, double dwell) {
     ToolMove m;
     m.kind = kind;
     m.tip_mm = tip;

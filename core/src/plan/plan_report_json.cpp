@@ -188,15 +188,37 @@ struct Fields<ReportSheet> {
   static constexpr bool omit_empty(std::string_view key) { return key == "slot" || key == "jet_compensation" || key == "jet_tilt_limited"; }
 };
 template <>
+struct Fields<ReportAsCutFigures> {
+  using S = ReportAsCutFigures;
+  static constexpr auto all =
+      std::tuple{Field{"volume_mm3", &S::volume_mm3}, Field{"volume_pct", &S::volume_pct}, Field{"max_mm", &S::max_mm},
+                 Field{"max_at_mm", &S::max_at_mm}};
+};
+template <>
+struct Fields<ReportAsCutLayer> {
+  using S = ReportAsCutLayer;
+  static constexpr auto all = std::tuple{Field{"layer", &S::layer},   Field{"model_volume_mm3", &S::model_volume_mm3},
+                                         Field{"planned", &S::planned}, Field{"as_cut", &S::as_cut},
+                                         Field{"parts", &S::parts},   Field{"parts_freed", &S::parts_freed}};
+};
+template <>
+struct Fields<ReportAsCut> {
+  using S = ReportAsCut;
+  static constexpr auto all =
+      std::tuple{Field{"dir", &S::dir},       Field{"model_volume_mm3", &S::model_volume_mm3}, Field{"planned", &S::planned},
+                 Field{"as_cut", &S::as_cut}, Field{"parts", &S::parts},                       Field{"parts_freed", &S::parts_freed},
+                 Field{"not_freed", &S::not_freed}, Field{"layers", &S::layers}};
+};
+template <>
 struct Fields<PlanReport> {
   using S = PlanReport;
   static constexpr auto all = std::tuple{
       Field{"model", &S::model},           Field{"settings", &S::settings},     Field{"layers", &S::layers},
       Field{"stack", &S::stack},           Field{"shortfalls", &S::shortfalls}, Field{"deviation", &S::deviation},
       Field{"warnings", &S::warnings},     Field{"timing_s", &S::timing_s},     Field{"cam", &S::cam},
-      Field{"sheets", &S::sheets}};
+      Field{"sheets", &S::sheets},         Field{"as_cut", &S::as_cut}};
   // Members that are left out of the file when empty, rather than written as null.
-  static constexpr bool omit_empty(std::string_view key) { return key == "cam" || key == "sheets"; }
+  static constexpr bool omit_empty(std::string_view key) { return key == "cam" || key == "sheets" || key == "as_cut"; }
 };
 
 template <class T>

@@ -226,6 +226,28 @@ std::expected<void, Error> apply_shifts(const std::vector<ToolMove>& moves, cons
   return {};
 }
 
+// Step 4: a vertical head's C is free (every C gives the same axis), so runs of vertical moves
+// take it from their tilted neighbours: the first from the move before, the rest from the move
+// after. A pivot head then never turns C while A leaves or reaches 0 — a C sweep with A tilting
+// swings the tip on a circle of pivot·sin A (5 mm at 2° on a 150 mm pivot) — and C turns in the
+// run's vertical moves (the rapid down to the pierce), where it moves nothing.
+void align_vertical_c(std::vector<AxisPose>& poses) {
+  const std::size_t n = poses.size();
+  for (std::size_t b = 0; b < n;) {
+    if (poses[b].a_rad != 0.0) {
+      ++b;
+      continue;
+    }
+    std::size_t e = b;
+    while (e < n && poses[e].a_rad == 0.0) ++e;
+    const bool has_before = b > 0, has_after = e < n;
+    if (has_after)
+      for (std::size_t m = has_before ? b + 1 : b; m < e; ++m) poses[m].c_rad = poses[e].c_rad;
+    if (has_before) poses[b].c_rad = poses[b - 1].c_rad;
+    b = e;
+  }
+}
+
 }  // namespace
 
 std::expected<std::vector<AxisPose>, Error> plan_machine_axes(const SheetToolpath& toolpath,
@@ -235,11 +257,13 @@ std::expected<std::vector<AxisPose>, Error> plan_machine_axes(const SheetToolpat
   auto poses = continuous_inverse(toolpath.moves, *contour_of, head);
   if (!poses) return poses;
   const bool limited = std::isfinite(head.c_min_rad) || std::isfinite(head.c_max_rad);
-  if (!limited || toolpath.moves.empty()) return poses;
-  auto shift = contour_shifts(toolpath, head, *poses);
-  if (!shift) return std::unexpected(shift.error());
-  const std::vector<double> applied = move_shifts(toolpath.moves, *contour_of, *shift);
-  if (auto ok = apply_shifts(toolpath.moves, *contour_of, applied, head, *poses); !ok) return std::unexpected(ok.error());
+  if (limited && !toolpath.moves.empty()) {
+    auto shift = contour_shifts(toolpath, head, *poses);
+    if (!shift) return std::unexpected(shift.error());
+    const std::vector<double> applied = move_shifts(toolpath.moves, *contour_of, *shift);
+    if (auto ok = apply_shifts(toolpath.moves, *contour_of, applied, head, *poses); !ok) return std::unexpected(ok.error());
+  }
+  align_vertical_c(*poses);
   return poses;
 }
 

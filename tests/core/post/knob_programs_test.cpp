@@ -114,6 +114,48 @@ INSTANTIATE_TEST_SUITE_P(Dialects, KnobPrograms,
                                   (info.param.rtcp ? "_rtcp" : "_pivot");
                          });
 
+// Between its ends a pivot program's block is the joints moving together, not the tip: the tip
+// follows forward kinematics of the interpolated joints. In a block that turns the head far (the
+// lead-in from the vertical pierce to a 60° line, the rapid that sets the head straight again)
+// it dives off its line, 20 mm into the sheet at a 150 mm pivot. Every block of every sheet,
+// read back from the grblHAL pivot program: the cut's tip within 0.03 mm of the straight line
+// between the block's ends, a rapid's never below the sheet's top face.
+TEST(KnobSheets, APivotHeadsTipStaysOnItsLineBetweenTheBlocksEnds) {
+  const KnobSheets& k = knob();
+  HeadKinematics head;
+  head.rtcp = false;  // pivot coordinates, G93: the joints interpolate
+  PostParams params;
+  params.dialect = PostDialect::grblhal;
+  double worst_cut_mm = 0.0, lowest_rapid_mm = 1e9;
+  for (const SheetToolpath& tp : k.toolpaths) {
+    const RoundTrip rt = round_trip(tp, head, params);
+    ASSERT_FALSE(::testing::Test::HasFailure());
+    const auto& lines = rt.read.motions;
+    for (std::size_t j = 1; j < lines.size(); ++j) {
+      const TipAxis from = forward(lines[j - 1], head), to = forward(lines[j], head);
+      for (const double f : {0.25, 0.5, 0.75}) {
+        gcode_reader::MotionLine mid = lines[j];
+        mid.x = lines[j - 1].x + f * (lines[j].x - lines[j - 1].x);
+        mid.y = lines[j - 1].y + f * (lines[j].y - lines[j - 1].y);
+        mid.z = lines[j - 1].z + f * (lines[j].z - lines[j - 1].z);
+        mid.a_deg = lines[j - 1].a_deg + f * (lines[j].a_deg - lines[j - 1].a_deg);
+        mid.c_deg = lines[j - 1].c_deg + f * (lines[j].c_deg - lines[j - 1].c_deg);
+        const Eigen::Vector3d tip = forward(mid, head).tip;
+        if (lines[j].motion == 0) {
+          lowest_rapid_mm = std::min(lowest_rapid_mm, tip.z());
+          EXPECT_GE(tip.z(), -1e-3) << "sheet " << tp.sheet << ": " << lines[j].text;
+        } else {
+          const Eigen::Vector3d on_line = from.tip + f * (to.tip - from.tip);
+          worst_cut_mm = std::max(worst_cut_mm, (tip - on_line).norm());
+          EXPECT_LE((tip - on_line).norm(), 0.03) << "sheet " << tp.sheet << ": " << lines[j - 1].text << " → " << lines[j].text;
+        }
+        if (::testing::Test::HasFailure()) return;  // the first says enough
+      }
+    }
+  }
+  std::printf("worst tip off its line in a cut: %.4f mm; lowest rapid tip: %.3f mm\n", worst_cut_mm, lowest_rapid_mm);
+}
+
 TEST(KnobSheets, PartsInsideTheirSheetsNumberedAndThinBeforeThick) {
   const KnobSheets& k = knob();
   std::vector<int> seen(k.parts.size(), 0);

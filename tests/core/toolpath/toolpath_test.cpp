@@ -30,7 +30,8 @@ ToolpathParams params_with_kerf(double kerf) {
 std::vector<Eigen::Vector3d> cut_tips(const SheetToolpath& tp, const ToolContour& c) {
   std::vector<Eigen::Vector3d> out;
   for (std::size_t i = c.first_move; i < c.end_move; ++i)
-    if (tp.moves[i].kind == MoveKind::lead_in || tp.moves[i].kind == MoveKind::cut) out.push_back(tp.moves[i].tip_mm);
+    if ((tp.moves[i].kind == MoveKind::lead_in || tp.moves[i].kind == MoveKind::cut) && !tp.moves[i].turn_piece)
+      out.push_back(tp.moves[i].tip_mm);
   return out;
 }
 

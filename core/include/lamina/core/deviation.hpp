@@ -10,6 +10,7 @@
 #include <Eigen/Core>
 
 #include <expected>
+#include <span>
 #include <vector>
 
 namespace lamina {
@@ -22,6 +23,9 @@ namespace lamina {
 // more than half of whose length runs against its outline (cut past its own axis, where it can
 // come out wound the right way again) keeps nothing: an outer no material, a hole no hole.
 std::vector<Polygon2> layer_section(const LayerPlan& layer, double z_mm);
+// The same for some of its outlines (indices into layer.outlines; others ignored): one part's
+// material, its outer outline and its holes.
+std::vector<Polygon2> layer_section(const LayerPlan& layer, double z_mm, std::span<const int> outlines);
 
 // More sections than this is a mistake in the parameters, not a finer answer (a 1e-5 mm step
 // over the knob ran for minutes, issue 17 item 7): 0.05 mm over a metre, 1.5 µm over the knob.

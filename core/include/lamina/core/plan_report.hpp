@@ -152,6 +152,29 @@ struct ReportSheet {
   std::optional<std::int64_t> jet_tilt_limited;  // its cut lines whose compensation the tilt limit held back
 };
 
+// The part as cut, beside the plan (lamina plan --as-cut; lamina/core/as_cut.hpp): both measured
+// the same way, slab by slab at the depths the cut sheets were sectioned at.
+struct ReportAsCutFigures {
+  double volume_mm3 = 0.0, volume_pct = 0.0, max_mm = 0.0;
+  std::array<double, 3> max_at_mm{};
+};
+
+struct ReportAsCutLayer {
+  std::int64_t layer = 0;
+  double model_volume_mm3 = 0.0;
+  ReportAsCutFigures planned, as_cut;
+  std::int64_t parts = 0, parts_freed = 0;
+};
+
+struct ReportAsCut {
+  std::string dir;  // where the sheets' sections were read
+  double model_volume_mm3 = 0.0;
+  ReportAsCutFigures planned, as_cut;
+  std::int64_t parts = 0, parts_freed = 0;
+  std::vector<std::string> not_freed;
+  std::vector<ReportAsCutLayer> layers;
+};
+
 struct PlanReport {
   ReportModel model;
   ReportSettings settings;
@@ -163,6 +186,7 @@ struct PlanReport {
   ReportTiming timing_s;
   std::optional<ReportCam> cam;                  // absent when no programs were made
   std::optional<std::vector<ReportSheet>> sheets;  // likewise
+  std::optional<ReportAsCut> as_cut;               // only with --as-cut
 };
 
 // report.json's text: two-space indented, keys in the order above, a newline at the end.

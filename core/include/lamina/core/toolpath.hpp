@@ -43,6 +43,9 @@ struct ToolMove {
   bool jet_on = false;         // the jet's state during the move (on from the pierce to the end of the lead-out)
   int contour = -1;            // index into SheetToolpath::contours; -1 for rapids between contours
   bool tilt_limited = false;   // a cut whose jet compensation the head's tilt limit held back (drawn on the sheet)
+  // Not a planned point but one on the way to the next: a move that turns the head further than
+  // ToolpathParams::max_turn_per_move_rad goes out in pieces, all but the last of them marked.
+  bool turn_piece = false;
 };
 
 // One cut from pierce to lead-out: a whole pass around an outline, or a run of it (a trim run,
@@ -115,6 +118,12 @@ struct ToolpathParams {
   double microjoint_width_mm = 0.6;  // uncut length of one microjoint
   double dowel_diameter_mm = 6.0;    // of the parts' dowel holes (Part::dowels_mm), cut vertical
   double rapid_mm_per_s = 250.0;
+  // No move turns the jet's axis by more than this: a pivot head without RTCP interpolates its
+  // joints, so in a move that turns the axis by θ its tip strays from the straight line by up to
+  // pivot·(1 − cos θ/2) — 20 mm, through the sheet, for a lead-in from the vertical pierce to a
+  // 60° line at a 150 mm pivot. Longer turns are split (the tip along its line, the axis by
+  // slerp, the time shared): 2° keeps a 150 mm pivot's tip within 0.023 mm.
+  double max_turn_per_move_rad = 0.03490658503988659;
   // Slow-down into sharp corners: a corner turning more than corner_angle_rad (in the top face) is
   // entered and left at feed · max(corner_min_fraction, cos(turn/2)).
   double corner_angle_rad = 0.5235987755982988;  // 30°

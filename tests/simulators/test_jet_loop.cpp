@@ -1,0 +1,115 @@
+// The whole of issue 20 on machines whose jet the planner does not know: lamina-sim's physics
+// (jet_physics.hpp) → Lamina's coupon cut and measured on it → `lamina calibrate fit` → the knob
+// planned with and without jet compensation → every sheet cut on the simulator
+// (`lamina-sim --as-cut`) → `lamina plan --as-cut` measures the part as cut beside the plan.
+// With compensation the part as cut is within 25 % of the plan's own volume deviation at
+// qualities 3 and 5, and at quality 5 the deviation the jet adds (as cut − planned) is at least
+// 3x smaller than without. A second machine (a soft material's jet: reversed taper up to a faster
+// speed, less trail-back) is held to the same. Quality 1 (the separation speed) does not meet the
+// targets yet (docs/jet.md): LAMINA_JET_LOOP_QUALITIES=1,3,5 prints it too. The numbers are
+// printed for docs/jet.md.
+#include "coupon_loop.hpp"
+
+#include <fmt/format.h>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+namespace {
+
+namespace fs = std::filesystem;
+using coupon_loop::run;
+
+const std::string kMaterial = "'aluminium 6061-T6'";
+
+struct AsCutFigures {
+  double planned_pct = 0.0, as_cut_pct = 0.0, planned_max_mm = 0.0, as_cut_max_mm = 0.0;
+  int parts = 0, freed = 0;
+};
+
+nlohmann::json read_json(const fs::path& file) {
+  std::ifstream in(file);
+  return nlohmann::json::parse(in, nullptr, false);
+}
+
+// Plans the knob (`plan_args`), cuts every sheet on `machine`, and measures it as cut.
+AsCutFigures cut_the_knob(const fs::path& dir, const fs::path& machine, const std::string& plan_args) {
+  const std::string cli = LAMINA_CLI, sim = LAMINA_SIM;
+  const std::string plan = cli + " plan " + std::string(LAMINA_EXAMPLES_DIR) + "/knob.stl --material " + kMaterial +
+                           " --dowels 0 " + plan_args;
+  std::string out = run(plan + " --out " + (dir / "plan").string() + " > /dev/null");
+  const nlohmann::json report = read_json(dir / "plan" / "report.json");
+  EXPECT_TRUE(report.contains("sheets")) << out;
+  if (!report.contains("sheets")) return {};
+  for (const auto& sheet : report["sheets"]) {
+    const fs::path program = dir / "plan" / sheet["program"].get<std::string>();
+    const fs::path as_cut = dir / "plan" / fmt::format("sheet-{}.ascut.json", sheet["index"].get<int>());
+    out = run(sim + " --machine " + machine.string() + " --as-cut " + program.string() + " --sheet-thickness " +
+              fmt::format("{}", sheet["thickness_mm"].get<double>()) + " --as-cut-out " + as_cut.string());
+    EXPECT_TRUE(out.empty()) << out;
+  }
+  out = run(plan + " --out " + (dir / "measured").string() + " --as-cut " + (dir / "plan").string() + " > /dev/null");
+  const nlohmann::json measured = read_json(dir / "measured" / "report.json");
+  EXPECT_TRUE(measured.contains("as_cut")) << out;
+  if (!measured.contains("as_cut")) return {};
+  const auto& a = measured["as_cut"];
+  return {a["planned"]["volume_pct"], a["as_cut"]["volume_pct"], a["planned"]["max_mm"], a["as_cut"]["max_mm"],
+          a["parts"], a["parts_freed"]};
+}
+
+struct Machine {
+  std::string name, jet_keys;
+};
+
+// The qualities to run: 3 and 5, or LAMINA_JET_LOOP_QUALITIES ("1,3,5").
+std::vector<int> qualities() {
+  const char* env = std::getenv("LAMINA_JET_LOOP_QUALITIES");
+  std::vector<int> out;
+  std::stringstream list(env ? env : "3,5");
+  for (std::string q; std::getline(list, q, ',');) out.push_back(std::stoi(q));
+  return out;
+}
+
+void check_machine(const Machine& m, const std::vector<int>& qualities) {
+  const fs::path dir = fs::temp_directory_path() / ("lamina-jet-loop-" + m.name);
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const auto [kerf, fit_out] = coupon_loop::calibrate_on(m.name, m.jet_keys);
+  ASSERT_NE(fit_out.find("wrote the kerf"), std::string::npos) << fit_out;
+  std::ofstream(dir / "kerf.toml") << kerf;
+  std::ofstream(dir / "machine.toml") << "head_pivot_mm = 150\n" << m.jet_keys;
+  for (const int q : qualities) {
+    std::map<std::string, AsCutFigures> by_mode;
+    for (const std::string mode : {"off", "full"}) {
+      const fs::path case_dir = dir / fmt::format("q{}-{}", q, mode);
+      by_mode[mode] = cut_the_knob(case_dir, dir / "machine.toml",
+                                   fmt::format("--quality {} --jet-compensation {} --kerf-file {}", q, mode, (dir / "kerf.toml").string()));
+      const AsCutFigures& f = by_mode[mode];
+      std::printf("%s q%d %-4s: planned %.3f %% / %.3f mm, as cut %.3f %% / %.3f mm, %d of %d parts freed\n", m.name.c_str(), q,
+                  mode.c_str(), f.planned_pct, f.planned_max_mm, f.as_cut_pct, f.as_cut_max_mm, f.freed, f.parts);
+      if (q > 1) EXPECT_EQ(f.freed, f.parts) << m.name << " q" << q << " " << mode << ": every part comes out of its sheet";
+      EXPECT_GT(f.parts, 0);
+    }
+    const AsCutFigures &off = by_mode["off"], &full = by_mode["full"];
+    EXPECT_NEAR(full.planned_pct, off.planned_pct, 1e-9) << "the same plan, cut two ways";
+    if (q == 1) continue;  // printed only (see the top)
+    EXPECT_LE(std::abs(full.as_cut_pct - full.planned_pct), 0.25 * full.planned_pct)
+        << m.name << " q" << q << ": compensated, as cut within 25 % of the plan";
+    if (q == 5)
+      EXPECT_LE(std::abs(full.as_cut_pct - full.planned_pct), (off.as_cut_pct - off.planned_pct) / 3.0)
+          << m.name << ": at quality 5, the jet's share 3x smaller than without";
+  }
+  fs::remove_all(dir);
+}
+
+TEST(JetLoop, TheKnobAsCutFollowsItsPlanWithCompensation) {
+  check_machine({"hard", "jet_separation_mm_per_s_at_10mm = 30\njet_taper_gain = 0.04\njet_taper_offset = 0.002\n"}, qualities());
+}
+
+TEST(JetLoop, OnASecondMachineToo) {
+  check_machine({"soft", "jet_separation_mm_per_s_at_10mm = 36\njet_taper_gain = 0.05\njet_taper_offset = 0.012\n"
+                         "jet_lag_max_deg = 18\njet_slow_widening = 0.3\n"},
+                qualities());
+}
+
+}  // namespace
