@@ -50,6 +50,7 @@ std::expected<std::size_t, Error> compensate_jet(std::vector<PathPoint>& points,
     q.bottom += (kerf->bottom_width_mm / 2.0 - in.half_kerf_mm) * scrap;
     // The exit trails the entry by the trail-back: aim it that far ahead.
     if (in.mode == JetCompensationMode::full) q.bottom += kerf->trail_back_mm * travel_at(planned, i, in.closed);
+    q.trail_back_mm = kerf->trail_back_mm;
     q.tilt_limited = hold_to_limit(q, in.tilt_max_rad, in.thickness_mm);
     held += q.tilt_limited;
   }

@@ -289,6 +289,7 @@ class SheetBuilder {
     if (tabs_u.empty()) {
       std::vector<PathPoint> ring = final_pass.points;
       ring.push_back(ring.front());
+      append_overcut(ring);
       emit_contour(std::move(ring), final_pass.points, t, kFreeingRing);
       return {};
     }
@@ -410,6 +411,21 @@ class SheetBuilder {
   }
 
   // The jet is on for every move but a rapid (the pierce opens it, the lead-out closes the cut).
+  // A ring that frees a part runs on past its start by the jet's trail-back (known under jet
+  // compensation; none without it, so those programs are as before): the jet's lower part lags
+  // the nozzle, and a lead-out straight from the start would leave the bottom of the ring's last
+  // stretch uncut — a tab that holds the part (JetLoop: the knob's 10 mm flange at quality 1).
+  static void append_overcut(std::vector<PathPoint>& ring) {
+    const double want_mm = ring.back().trail_back_mm;
+    if (!(want_mm > 0.0)) return;
+    const std::size_t closing = ring.size() - 1;  // ring[closing] is ring[0] again
+    double run_mm = 0.0;
+    for (std::size_t k = 1; k < closing && run_mm < want_mm; ++k) {
+      run_mm += (ring[k].tip - ring[k - 1].tip).norm();
+      ring.push_back(ring[k]);
+    }
+  }
+
   // A move whose axis turns more than max_turn_per_move_rad from the last one goes out in pieces
   // (ToolpathParams::max_turn_per_move_rad: a pivot head's tip would leave its line).
   void push(MoveKind kind, const Eigen::Vector3d& tip, const Eigen::Vector3d& axis, double feed, double duration,

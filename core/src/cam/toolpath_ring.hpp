@@ -37,6 +37,7 @@ struct PathPoint {
   double feed_mm_per_s = 0.0;                        // the feed model's at this line's tilt
   double corner_factor = 1.0;                        // slow-down at a sharp corner of the top path
   bool tilt_limited = false;                         // jet compensation held at the head's tilt limit
+  double trail_back_mm = 0.0;                        // the jet's trail-back here (jet compensation; 0 without it)
 };
 
 // How long the jet takes from one line to the next: the longer of the top's and the bottom's
