@@ -421,8 +421,16 @@ class SheetBuilder {
     const std::size_t closing = ring.size() - 1;  // ring[closing] is ring[0] again
     double run_mm = 0.0;
     for (std::size_t k = 1; k < closing && run_mm < want_mm; ++k) {
-      run_mm += (ring[k].tip - ring[k - 1].tip).norm();
-      ring.push_back(ring[k]);
+      const double step = (ring[k].tip - ring[k - 1].tip).norm();
+      PathPoint q = ring[k];
+      if (run_mm + step > want_mm) {  // the last one stops at the trail-back, on the line between
+        const double f = (want_mm - run_mm) / step;
+        q.tip = ring[k - 1].tip + f * (ring[k].tip - ring[k - 1].tip);
+        q.bottom = ring[k - 1].bottom + f * (ring[k].bottom - ring[k - 1].bottom);
+        q.axis = (q.tip - q.bottom).normalized();
+      }
+      run_mm += step;
+      ring.push_back(q);
     }
   }
 

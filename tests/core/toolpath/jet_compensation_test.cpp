@@ -47,13 +47,17 @@ struct EdgeMove {
   Eigen::Vector3d tip, bottom, travel;
 };
 
-// Cut moves in the middle of the outer square's edges (the corners' mitres left out).
+// Cut moves in the middle of the outer square's edges (the corners' mitres left out), once round
+// (the overlap past the start left out).
 std::vector<EdgeMove> edge_moves(const SheetToolpath& tp) {
   std::vector<EdgeMove> out;
   const ToolContour& outer = tp.contours.back();
-  for (std::size_t i = outer.first_move + 1; i < outer.end_move; ++i) {
+  std::size_t start = outer.first_move;
+  while (tp.moves[start].kind != MoveKind::lead_in || tp.moves[start].turn_piece) ++start;
+  for (std::size_t i = start + 1; i < outer.end_move; ++i) {
     const ToolMove& m = tp.moves[i];
     if (m.kind != MoveKind::cut) continue;
+    if (i > start + 1 && (tp.moves[i - 1].tip_mm - tp.moves[start].tip_mm).norm() < 1e-9) break;  // round once
     const Eigen::Vector2d d = (m.tip_mm.head<2>() - kCentre).cwiseAbs();
     if (std::min(d.x(), d.y()) > kHalfSide - 5.0) continue;
     const Eigen::Vector3d bottom = m.tip_mm - m.axis * (kThickness / m.axis.z());
@@ -98,6 +102,34 @@ TEST(JetCompensation, FullAimsTheExitAheadByTheTrailBack) {
     EXPECT_NEAR(lead.dot(m.travel), k.trail_back_mm, 1e-6) << "the bottom leads the tip along the travel";
     EXPECT_NEAR(outside_square(m.bottom), k.bottom_width_mm / 2.0, 1e-9);
   }
+}
+
+// The jet's lower part lags the nozzle: a ring that frees the part runs on past its start by the
+// trail-back before it leaves, or the bottom of its last stretch stays uncut (a tab). Without
+// compensation the trail-back is not known and the ring closes where it began, as before.
+TEST(JetCompensation, AFreeingRingRunsPastItsStartByTheTrailBack) {
+  auto f = square();
+  auto overlap_mm = [&](JetCompensationMode mode) {
+    auto tp = plan_sheet_toolpath(f.plan, f.parts, f.sheet, aluminium(), with(mode));
+    EXPECT_TRUE(tp) << tp.error().message;
+    const ToolContour& outer = tp->contours.back();
+    EXPECT_TRUE(outer.frees && outer.closed);
+    // The tips after the ring came back to its first cut's tip, to the lead-out.
+    std::size_t first = outer.first_move;
+    while (tp->moves[first].kind != MoveKind::lead_in || tp->moves[first].turn_piece) ++first;
+    double run = 0.0;
+    bool back = false;
+    for (std::size_t i = first + 1; i < outer.end_move && tp->moves[i].kind == MoveKind::cut; ++i) {
+      if (back) run += (tp->moves[i].tip_mm - tp->moves[i - 1].tip_mm).norm();
+      back = back || (tp->moves[i].tip_mm - tp->moves[first].tip_mm).norm() < 1e-9;
+    }
+    return run;
+  };
+  const KerfShape k = expected_kerf(with(JetCompensationMode::full));
+  ASSERT_GT(k.trail_back_mm, 0.05);
+  EXPECT_NEAR(overlap_mm(JetCompensationMode::full), k.trail_back_mm, 1e-6);
+  EXPECT_NEAR(overlap_mm(JetCompensationMode::taper), k.trail_back_mm, 1e-6);
+  EXPECT_EQ(overlap_mm(JetCompensationMode::off), 0.0);
 }
 
 TEST(JetCompensation, OffKeepsTheProgramByteForByte) {
