@@ -9,6 +9,7 @@
 #include "lamina/core/toolpath.hpp"
 
 #include "cam/jet_compensation.hpp"
+#include "cam/toolpath_moves.hpp"
 #include "cam/toolpath_ring.hpp"
 
 #include <fmt/format.h>
@@ -289,7 +290,7 @@ class SheetBuilder {
     if (tabs_u.empty()) {
       std::vector<PathPoint> ring = final_pass.points;
       ring.push_back(ring.front());
-      append_overcut(ring);
+      cam_detail::append_overlap(ring);
       emit_contour(std::move(ring), final_pass.points, t, kFreeingRing);
       return {};
     }
@@ -411,51 +412,8 @@ class SheetBuilder {
   }
 
   // The jet is on for every move but a rapid (the pierce opens it, the lead-out closes the cut).
-  // A ring that frees a part runs on past its start by the jet's trail-back (known under jet
-  // compensation; none without it, so those programs are as before): the jet's lower part lags
-  // the nozzle, and a lead-out straight from the start would leave the bottom of the ring's last
-  // stretch uncut — a tab that holds the part (JetLoop: the knob's 10 mm flange at quality 1).
-  static void append_overcut(std::vector<PathPoint>& ring) {
-    const double want_mm = ring.back().trail_back_mm;
-    if (!(want_mm > 0.0)) return;
-    const std::size_t closing = ring.size() - 1;  // ring[closing] is ring[0] again
-    double run_mm = 0.0;
-    for (std::size_t k = 1; k < closing && run_mm < want_mm; ++k) {
-      const double step = (ring[k].tip - ring[k - 1].tip).norm();
-      PathPoint q = ring[k];
-      if (run_mm + step > want_mm) {  // the last one stops at the trail-back, on the line between
-        const double f = (want_mm - run_mm) / step;
-        q.tip = ring[k - 1].tip + f * (ring[k].tip - ring[k - 1].tip);
-        q.bottom = ring[k - 1].bottom + f * (ring[k].bottom - ring[k - 1].bottom);
-        q.axis = (q.tip - q.bottom).normalized();
-      }
-      run_mm += step;
-      ring.push_back(q);
-    }
-  }
-
-  // A move whose axis turns more than max_turn_per_move_rad from the last one goes out in pieces
-  // (ToolpathParams::max_turn_per_move_rad: a pivot head's tip would leave its line).
   void push(MoveKind kind, const Eigen::Vector3d& tip, const Eigen::Vector3d& axis, double feed, double duration,
             int contour, double dwell = 0.0) {
-    if (!out_.moves.empty()) {
-      const Eigen::Vector3d from_tip = out_.moves.back().tip_mm, from_axis = out_.moves.back().axis;
-      const double turn = std::acos(std::clamp(from_axis.dot(axis), -1.0, 1.0));
-      const auto pieces = static_cast<int>(std::ceil(turn / p_.max_turn_per_move_rad - 1e-9));
-      for (int i = 1; i < pieces; ++i) {
-        const double f = static_cast<double>(i) / pieces;
-        const Eigen::Vector3d between =
-            (std::sin((1.0 - f) * turn) * from_axis + std::sin(f * turn) * axis) / std::sin(turn);
-        append(kind, from_tip + (tip - from_tip) * f, between.normalized(), feed, duration / pieces, contour, 0.0);
-        out_.moves.back().turn_piece = true;
-      }
-      if (pieces > 1) duration /= pieces;
-    }
-    append(kind, tip, axis, feed, duration, contour, dwell);
-  }
-
-  void append(MoveKind kind, const Eigen::Vector3d& tip, const Eigen::Vector3d& axis, double feed, double duration,
-              int contour, double dwell) {
     ToolMove m;
     m.kind = kind;
     m.tip_mm = tip;
@@ -465,7 +423,7 @@ class SheetBuilder {
     m.dwell_s = dwell;
     m.jet_on = kind != MoveKind::rapid;
     m.contour = contour;
-    out_.moves.push_back(m);
+    cam_detail::append_move(out_.moves, m, p_.max_turn_per_move_rad);
   }
 
   void rapid_to(const Eigen::Vector3d& tip, const Eigen::Vector3d& axis, int contour) {
