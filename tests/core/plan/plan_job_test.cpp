@@ -86,6 +86,30 @@ TEST(PlanJob, ReportJsonReadsBackToTheSameText) {
   EXPECT_EQ(back->sheets->front().parts.size(), planned().report.sheets->front().parts.size());
 }
 
+// `lamina plan --as-cut` adds the part as cut beside the plan; it reads back, and without it the
+// key is left out of the file (reports without it read as they did).
+TEST(PlanJob, TheAsCutFiguresReadBackAndAreLeftOutWithoutThem) {
+  PlanReport report = planned().report;
+  EXPECT_EQ(plan_report_json(report).find("\"as_cut\""), std::string::npos);
+  ReportAsCut a;
+  a.dir = "cut";
+  a.model_volume_mm3 = 1000.0;
+  a.planned = {5.0, 0.5, 0.6, {1.0, 2.0, 3.0}};
+  a.as_cut = {7.5, 0.75, 0.9, {4.0, 5.0, 6.0}};
+  a.parts = 3;
+  a.parts_freed = 2;
+  a.not_freed = {"L2-1 on sheet 1 at 4.5 mm"};
+  a.layers.push_back({2, 400.0, {1.0, 0.25, 0.6, {1.0, 2.0, 3.0}}, {2.0, 0.5, 0.9, {4.0, 5.0, 6.0}}, 1, 0});
+  report.as_cut = a;
+  const std::string text = plan_report_json(report);
+  auto back = parse_plan_report(text);
+  ASSERT_TRUE(back) << back.error().message;
+  EXPECT_EQ(plan_report_json(*back), text);
+  ASSERT_TRUE(back->as_cut);
+  EXPECT_EQ(back->as_cut->not_freed, a.not_freed);
+  EXPECT_EQ(back->as_cut->layers.at(0).as_cut.max_at_mm[2], 6.0);
+}
+
 // A reader of the programs (the web console's 3D toolpath) needs the head to turn X Y Z A C into
 // the tool tip and axis, and the operator the rack slot each sheet is taken from.
 TEST(PlanJob, TheReportCarriesTheHeadAndEachSheetsRackSlot) {
