@@ -15,7 +15,9 @@
 
 namespace lamina::cli {
 
-// FNV-1a, 64 bits, 16 hex digits, as lamina-sim writes it.
+// FNV-1a, 64 bits, 16 hex digits, as lamina-sim writes it. Written again there on purpose: the
+// simulator links nothing of Lamina's (it is the machine, an independent peer), and both sides
+// are tested against FNV-1a's published values, so the two cannot drift apart unseen.
 std::string program_fingerprint(std::string_view program);
 
 // parse_error naming the file and the key: "sheet-2.ascut.json: sections[3].pieces[0]: …".

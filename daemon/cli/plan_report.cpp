@@ -12,14 +12,24 @@ std::string fixed_or_dash(const std::optional<double>& v, int decimals) {
   return v ? fmt::format("{:.{}f}", *v, decimals) : std::string("-");
 }
 
+// Long tables show their first 20 and last 5 rows unless --all-rows; the line between says how
+// many are left out. True when row i is shown (the note printed in its place at row 20).
+bool row_shown(std::FILE* out, std::size_t i, std::size_t n, bool all_rows) {
+  const bool elide = !all_rows && n > 40;
+  if (elide && i == 20) fmt::print(out, "{:>5}   ({} more layers: --all-rows or report.json)\n", "...", n - 25);
+  return !(elide && i >= 20 && i < n - 5);
+}
+
+std::string freed_of(std::int64_t freed, std::int64_t parts) {
+  return freed == parts ? fmt::format("{}", parts) : fmt::format("{}/{}", freed, parts);
+}
+
 void print_layer_table(std::FILE* out, const PlanReport& report, bool all_rows) {
   fmt::print(out, "{:>5} {:>9} {:>6} {:>4} {:>6} {:>8} {:>8} {:>3}  {:>6} {:>7} {:>8} {:>5}\n", "layer", "z mm",
              "t mm", "sub", "passes", "dev mm", "est mm", "ok", "convex", "concave", "straight", "mixed");
   const std::size_t n = report.layers.size();
-  const bool elide = !all_rows && n > 40;
   for (std::size_t i = 0; i < n; ++i) {
-    if (elide && i == 20) fmt::print(out, "{:>5}   ({} more layers: --all-rows or report.json)\n", "...", n - 25);
-    if (elide && i >= 20 && i < n - 5) continue;
+    if (!row_shown(out, i, n, all_rows)) continue;
     const ReportLayer& l = report.layers[i];
     const ReportShapes& sh = l.shapes;
     fmt::print(out, "{:>5} {:>9.3f} {:>6.3g} {:>4} {:>6} {:>8.3f} {:>8} {:>3}  {:>6} {:>7} {:>8} {:>5}\n", l.index,
@@ -67,16 +77,14 @@ void print_plan_tables(std::FILE* out, const PlanReport& report, bool all_rows) 
 void print_as_cut_table(std::FILE* out, const ReportAsCut& a, bool all_rows) {
   fmt::print(out, "{:>5} {:>12} {:>12} {:>10} {:>10} {:>6}\n", "layer", "planned %", "as cut %", "planned mm", "as cut mm", "parts");
   const std::size_t n = a.layers.size();
-  const bool elide = !all_rows && n > 40;
   for (std::size_t i = 0; i < n; ++i) {
-    if (elide && i == 20) fmt::print(out, "{:>5}   ({} more layers: --all-rows or report.json)\n", "...", n - 25);
-    if (elide && i >= 20 && i < n - 5) continue;
+    if (!row_shown(out, i, n, all_rows)) continue;
     const ReportAsCutLayer& l = a.layers[i];
     fmt::print(out, "{:>5} {:>12.3f} {:>12.3f} {:>10.3f} {:>10.3f} {:>6}\n", l.layer, l.planned.volume_pct, l.as_cut.volume_pct,
-               l.planned.max_mm, l.as_cut.max_mm, l.parts_freed == l.parts ? fmt::format("{}", l.parts) : fmt::format("{}/{}", l.parts_freed, l.parts));
+               l.planned.max_mm, l.as_cut.max_mm, freed_of(l.parts_freed, l.parts));
   }
   fmt::print(out, "{:>5} {:>12.3f} {:>12.3f} {:>10.3f} {:>10.3f} {:>6}\n", "all", a.planned.volume_pct, a.as_cut.volume_pct,
-             a.planned.max_mm, a.as_cut.max_mm, a.parts_freed == a.parts ? fmt::format("{}", a.parts) : fmt::format("{}/{}", a.parts_freed, a.parts));
+             a.planned.max_mm, a.as_cut.max_mm, freed_of(a.parts_freed, a.parts));
   fmt::print(out, "  as cut ({}) beside the plan, both in the same slabs: % of the model's {:.6g} mm3 there;\n"
                   "  mm: largest distance from the cut wall to the model; parts: freed (of placed)\n",
              a.dir, a.model_volume_mm3);

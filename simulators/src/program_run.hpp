@@ -22,7 +22,8 @@ struct ProgramCallbacks {
 std::expected<void, std::string> run_program(std::string_view program, MachineConfig machine,
                                              const ProgramCallbacks& callbacks);
 
-// FNV-1a, 64 bits, as 16 hex digits: which program an as-cut record was cut from.
+// FNV-1a, 64 bits, as 16 hex digits: which program an as-cut record was cut from. Lamina reads it
+// with its own copy (daemon/cli/as_cut_files.cpp): the simulator links nothing of Lamina's.
 std::string program_fingerprint(std::string_view program);
 
 }  // namespace lamina::sim
