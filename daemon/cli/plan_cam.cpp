@@ -22,6 +22,8 @@ std::expected<void, Error> resolve_jet_compensation(const CamOptions& o, CamSett
   JetCompensation& jc = s.machine.cutting.jet_compensation;
   jc.mode = o.jet_compensation ? jet_compensation_modes().parse(*o.jet_compensation).value() : JetCompensationMode::automatic;
   jc.tilt_max_rad = std::min(-s.machine.head.a_min_rad, s.machine.head.a_max_rad);
+  if (o.corner_error_mm) jc.corners.error_mm = *o.corner_error_mm;
+  if (o.inside_corners) jc.corners.inside = inside_corner_strategies().parse(*o.inside_corners).value();
   if (jc.mode == JetCompensationMode::off) return {};
   const std::filesystem::path file =
       o.kerf_file.empty() ? std::filesystem::path(s.materials_source).parent_path() / "kerf.toml" : std::filesystem::path(o.kerf_file);
@@ -68,6 +70,14 @@ void add_cam_options(CLI::App& cmd, CamOptions& o) {
                  "The jet's real kerf (docs/jet.md): auto (full where the material is calibrated), off, taper or full")
       ->check(CLI::IsMember(jet_compensation_modes().names()));
   cmd.add_option("--kerf-file", o.kerf_file, "Kerf calibrations (lamina calibrate fit; default: kerf.toml beside the materials file)");
+  cmd.add_option("--corner-error", o.corner_error_mm,
+                 "Under jet compensation: the largest error the jet's lagging lower part may leave at a corner; "
+                 "corners are slowed until the kerf model's trail-back keeps it (mm, default 0.05)")
+      ->check(CLI::Range(0.001, 10.0));
+  cmd.add_option("--inside-corners", o.inside_corners,
+                 "Under jet compensation, inside corners of a part: slow (like outside ones) or keep the feed "
+                 "(a fillet of material stays at the bottom)")
+      ->check(CLI::IsMember(inside_corner_strategies().names()));
   cmd.add_flag("--no-programs", o.no_programs, "Stop after the stack: no nesting, programs or sheet drawings");
 }
 

@@ -28,6 +28,8 @@ struct CamOptions {
   std::optional<bool> rtcp, fill_holes;
   std::optional<std::string> jet_compensation;  // auto (default), off, taper, full
   std::string kerf_file;                        // default: kerf.toml beside the materials file
+  std::optional<double> corner_error_mm;        // the trail-back corners' allowance (JetCorners)
+  std::optional<std::string> inside_corners;    // slow (default) or keep
   bool no_programs = false;  // stop after the stack (no nesting, programs, drawings)
 };
 

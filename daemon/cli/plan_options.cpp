@@ -93,6 +93,10 @@ void add_plan_options(CLI::App& cmd, PlanOptions& o) {
   cmd.add_option("--deviation-step", o.deviation_step_mm, "Spacing of the sections the deviation is integrated over (mm)")
       ->check(in_range(0.0, true, 1e308, "mm"))
       ->capture_default_str();
+  cmd.add_option("--compare-strategies", o.compare_strategies,
+                 "Also measure the deviation of the strategies not chosen, on the same layering (true/false; it "
+                 "about doubles the time)")
+      ->capture_default_str();
   cmd.add_option("--out", o.out_dir, "Folder for report.json, stack.stl and, unless --no-programs, each sheet's program and drawing "
                  "(sheet-1.nc, sheet-1.svg, …); created if missing")->required();
   cmd.add_flag("--json", o.json, "Print the report as JSON on stdout instead of the tables");
@@ -133,6 +137,7 @@ std::expected<PlanSettings, Error> resolve_plan_settings(const PlanOptions& o) {
   s.tilt_max_deg = o.tilt_max_deg;
   s.tilt_max_rad = o.tilt_max_deg * std::numbers::pi / 180.0;  // the one degree → radian conversion
   s.deviation_step_mm = o.deviation_step_mm;
+  s.compare_strategies = o.compare_strategies;
   auto side = cut_sides().parse(o.side);
   auto strategy = bevel_strategies().parse(o.strategy);
   auto layering = layering_methods().parse(o.layering);

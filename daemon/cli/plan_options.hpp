@@ -30,6 +30,7 @@ struct PlanOptions {
   std::string strategy = "curved";
   std::string layering = "optimal";
   double deviation_step_mm = 0.1;
+  bool compare_strategies = false;
   std::string out_dir;
   bool json = false;
   bool all_rows = false;

@@ -49,8 +49,11 @@ void print_deviation_table(std::FILE* out, const PlanReport& report) {
       if (strategy == name)
         fmt::print(out, "{:<10} {:>14.2f} {:>9.3f} {:>8.3f}{}\n", name, d.volume_mm3, d.volume_pct, d.max_mm,
                    name == chosen ? "  (chosen)" : "");
-  fmt::print(out, "  (symmetric difference between stack and model, % of the model's {:.6g} mm3; max: largest distance)\n\n",
+  fmt::print(out, "  (symmetric difference between stack and model, % of the model's {:.6g} mm3; max: largest distance)\n",
              report.model.volume_mm3);
+  if (!report.settings.compare_strategies.value_or(true))
+    fmt::print(out, "  (the other strategies on the same layering: --compare-strategies true)\n");
+  fmt::print(out, "\n");
 }
 
 }  // namespace

@@ -55,7 +55,10 @@ const std::vector<Setting>& settings_table() {
       {"dowels", "--dowels", Kind::integer, 0, 64},
       {"dowel_diameter_mm", "--dowel-diameter", Kind::number, 0.5, 100},
       {"fill_holes", "--fill-holes", Kind::boolean},
+      {"compare_strategies", "--compare-strategies", Kind::boolean},
       {"jet_compensation", "--jet-compensation", Kind::text, 0, 0, jet_compensation_modes().names()},
+      {"corner_error_mm", "--corner-error", Kind::number, 0.001, 10},
+      {"inside_corners", "--inside-corners", Kind::text, 0, 0, inside_corner_strategies().names()},
   };
   return table;
 }

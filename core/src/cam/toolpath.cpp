@@ -9,6 +9,7 @@
 #include "lamina/core/toolpath.hpp"
 
 #include "cam/jet_compensation.hpp"
+#include "cam/jet_corners.hpp"
 #include "cam/toolpath_moves.hpp"
 #include "cam/toolpath_ring.hpp"
 
@@ -62,6 +63,11 @@ std::expected<void, Error> check_params(const ToolpathParams& p) {
     return std::unexpected(invalid(fmt::format("microjoint width {} mm must be > 0", p.microjoint_width_mm)));
   if (!(p.corner_min_fraction > 0.0 && p.corner_min_fraction <= 1.0))
     return std::unexpected(invalid(fmt::format("corner slow-down fraction {} must be in (0, 1]", p.corner_min_fraction)));
+  const JetCorners& jc = p.jet_compensation.corners;
+  if (!(std::isfinite(jc.error_mm) && jc.error_mm > 0.0))
+    return std::unexpected(invalid(fmt::format("corner error allowance {} mm must be > 0", jc.error_mm)));
+  if (!(jc.min_fraction > 0.0 && jc.min_fraction <= 1.0))
+    return std::unexpected(invalid(fmt::format("jet corner slow-down floor {} must be in (0, 1]", jc.min_fraction)));
   if (!finite_at_least(p.corner_angle_rad, 0.0))
     return std::unexpected(invalid(fmt::format("corner angle {} rad must be >= 0", p.corner_angle_rad)));
   return {};
@@ -200,6 +206,10 @@ class SheetBuilder {
     }
     const JetCompensationMode mode = jc.mode == JetCompensationMode::automatic ? JetCompensationMode::full : jc.mode;
     out_.jet_compensation = mode;
+    // The corners' speeds first: the compensation reads each line's feed ratio, slow-down included.
+    auto floored = cam_detail::jet_corner_speeds(pts, separation, {&model->second, sheet_.thickness_mm, jc.corners});
+    if (!floored) return std::unexpected(Error{floored.error().code, where + ", " + floored.error().message});
+    out_.jet_corners_floored += *floored;
     const cam_detail::JetCompensationInput in{mode, &model->second, sheet_.thickness_mm, 0.5 * p_.kerf_mm, jc.tilt_max_rad, true};
     auto held = cam_detail::compensate_jet(pts, separation, in);
     if (!held) return std::unexpected(Error{held.error().code, where + ", " + held.error().message});
@@ -467,11 +477,15 @@ class SheetBuilder {
     for (std::size_t k = 1; k < pts.size(); ++k) {
       const PathPoint& a = pts[k - 1];
       const PathPoint& b = pts[k];
-      const double f = std::min(a.feed_mm_per_s, b.feed_mm_per_s) * std::min(a.corner_factor, b.corner_factor);
-      const double dur = cam_detail::jet_travel_s(a.tip, a.bottom, b.tip, b.bottom, f);
-      if (dur <= 0.0) continue;  // a repeated line
-      push(MoveKind::cut, b.tip, b.axis, f, dur, id);
-      out_.moves.back().tilt_limited = b.tilt_limited;
+      PathPoint from = a;
+      for (const cam_detail::FeedPiece& piece : cam_detail::feed_pieces(a, b)) {
+        const double f = std::min(a.feed_mm_per_s, b.feed_mm_per_s) * piece.factor;
+        const double dur = cam_detail::jet_travel_s(from.tip, from.bottom, piece.to.tip, piece.to.bottom, f);
+        if (dur <= 0.0) continue;  // a repeated line
+        push(MoveKind::cut, piece.to.tip, piece.to.axis, f, dur, id);
+        out_.moves.back().tilt_limited = b.tilt_limited;
+        from = piece.to;
+      }
     }
     const double lead_out = fit_lead(p_.lead_out_mm, ring, end.tip.head<2>(), end.scrap);
     const Eigen::Vector2d out2 = end.tip.head<2>() + lead_out * end.scrap;
@@ -505,6 +519,20 @@ const ChoiceTable<JetCompensationMode>& jet_compensation_modes() {
       {JetCompensationMode::full, "full", "taper, and the exit aimed ahead by the trail-back"}};
   static constexpr ChoiceTable<JetCompensationMode> table{"jet compensation", rows};
   return table;
+}
+
+const ChoiceTable<InsideCorners>& inside_corner_strategies() {
+  static constexpr Choice<InsideCorners> rows[] = {
+      {InsideCorners::slow, "slow", "inside corners slowed like outside ones, to the corner allowance"},
+      {InsideCorners::keep, "keep", "inside corners at the feed: the bottom keeps a fillet of material, no time lost"}};
+  static constexpr ChoiceTable<InsideCorners> table{"inside corners", rows};
+  return table;
+}
+
+const char* inside_corners_name(InsideCorners s) {
+  for (const auto& row : inside_corner_strategies().rows())
+    if (row.value == s) return row.name.data();
+  return "slow";
 }
 
 const char* jet_compensation_name(JetCompensationMode mode) {

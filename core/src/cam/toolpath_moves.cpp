@@ -41,6 +41,11 @@ void append_overlap(std::vector<PathPoint>& ring) {
       q.tip = ring[k - 1].tip + f * (ring[k].tip - ring[k - 1].tip);
       q.bottom = ring[k - 1].bottom + f * (ring[k].bottom - ring[k - 1].bottom);
       q.axis = (q.tip - q.bottom).normalized();
+      // A corner's slow-down reaches the new end only as far as its zone goes.
+      if (std::isfinite(q.slow_zone_mm)) {
+        q.slow_zone_mm -= (1.0 - f) * step;
+        if (q.slow_zone_mm < 0.0) q.corner_factor = 1.0, q.slow_zone_mm = 0.0;
+      }
     }
     run_mm += step;
     ring.push_back(q);

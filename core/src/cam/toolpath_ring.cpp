@@ -119,8 +119,42 @@ PathPoint lerp(const PathPoint& a, const PathPoint& b, double t) {
   p.scrap = p.scrap.norm() > 1e-12 ? Eigen::Vector2d(p.scrap.normalized()) : a.scrap;
   p.feed_mm_per_s = std::min(a.feed_mm_per_s, b.feed_mm_per_s);
   p.corner_factor = 1.0;
+  // A point between two is slowed by a corner whose zone reaches it (the trail-back's corner
+  // speeds). The angle heuristic's infinite zones slow whole moves from their ends only, as before.
+  const double len = (b.tip - a.tip).norm();
+  for (const auto& [end, d] : {std::pair{&a, t * len}, std::pair{&b, (1.0 - t) * len}})
+    if (std::isfinite(end->slow_zone_mm) && d <= end->slow_zone_mm && end->corner_factor < p.corner_factor)
+      p.corner_factor = end->corner_factor, p.slow_zone_mm = end->slow_zone_mm - d;
   return p;
 }
+
+}  // namespace
+
+std::vector<FeedPiece> feed_pieces(const PathPoint& a, const PathPoint& b) {
+  const double len = (b.tip - a.tip).norm();
+  const auto factor_at = [&](double x) {
+    double f = 1.0;
+    if (x <= a.slow_zone_mm) f = std::min(f, a.corner_factor);
+    if (len - x <= b.slow_zone_mm) f = std::min(f, b.corner_factor);
+    return f;
+  };
+  // Where a's zone ends and b's begins, inside the move.
+  std::vector<double> cuts{0.0};
+  for (const double x : {a.slow_zone_mm, len - b.slow_zone_mm})
+    if (x > 1e-9 && x < len - 1e-9) cuts.push_back(x);
+  std::sort(cuts.begin(), cuts.end());
+  cuts.push_back(len);
+  std::vector<FeedPiece> out;
+  for (std::size_t k = 0; k + 1 < cuts.size(); ++k) {
+    const double f = factor_at(0.5 * (cuts[k] + cuts[k + 1]));
+    if (!out.empty() && out.back().factor == f) out.pop_back();  // one piece, extended below
+    out.push_back({k + 2 == cuts.size() ? b : lerp(a, b, cuts[k + 1] / len), f});
+  }
+  if (len <= 0.0) out = {{b, std::min(a.corner_factor, b.corner_factor)}};
+  return out;
+}
+
+namespace {
 
 // The point at arc length s on the closed path (any real s: it wraps).
 PathPoint point_at(const CompensatedPass& pass, double s) {

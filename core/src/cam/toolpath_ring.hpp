@@ -7,6 +7,7 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <limits>
 #include <vector>
 
 namespace lamina::cam_detail {
@@ -38,6 +39,9 @@ struct PathPoint {
   double corner_factor = 1.0;                        // slow-down at a sharp corner of the top path
   bool tilt_limited = false;                         // jet compensation held at the head's tilt limit
   double trail_back_mm = 0.0;                        // the jet's trail-back here (jet compensation; 0 without it)
+  // How far along the path, either side, corner_factor holds: infinite (the angle heuristic) is
+  // the whole of both moves that meet here; the trail-back's corner speeds hold it for the lag.
+  double slow_zone_mm = std::numeric_limits<double>::infinity();
 };
 
 // How long the jet takes from one line to the next: the longer of the top's and the bottom's
@@ -63,6 +67,16 @@ CompensatedPass compensate_pass(const LayerOutline& outline, const CutPass& pass
 // Corner slow-down factors on a closed path of points (in place): a turn of the tip path (in the top
 // face) sharper than corner_angle_rad gets max(min_fraction, cos(turn / 2)).
 void mark_corners(std::vector<PathPoint>& points, double corner_angle_rad, double min_fraction);
+
+// The move from a to b in pieces of one feed factor each: a's corner_factor within a's
+// slow_zone_mm of a, b's within b's of b, the slower where both hold, 1 where neither. The last
+// piece ends at b itself; with infinite zones (the angle heuristic) it is one piece at the
+// smaller factor, as before.
+struct FeedPiece {
+  PathPoint to;
+  double factor = 1.0;
+};
+std::vector<FeedPiece> feed_pieces(const PathPoint& a, const PathPoint& b);
 
 // Arc length on the closed tip path at a station parameter u ∈ [0, n): point floor(u), then the
 // fraction of the way to the next point.

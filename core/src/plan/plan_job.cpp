@@ -161,13 +161,16 @@ std::expected<void, PlanJobError> plan_on_rack(Run& run) {
   return {};
 }
 
-// The same layering cut three ways; the chosen strategy's plan is reused, not recomputed.
+// The chosen strategy's deviation and, when asked, the same layering cut the other two ways; the
+// chosen strategy's plan is reused, not recomputed.
 std::expected<void, PlanJobError> measure_strategies(Run& run) {
   constexpr BevelStrategy kAll[] = {BevelStrategy::vertical, BevelStrategy::sloped, BevelStrategy::curved};
   const PlanSettings& settings = run.q.settings;
+  std::vector<BevelStrategy> measured{settings.strategy};
+  if (settings.compare_strategies) measured.assign(std::begin(kAll), std::end(kAll));
   run.progress.start(PlanPhase::measuring_deviation);
   const auto t0 = Clock::now();
-  for (const BevelStrategy s : kAll) {
+  for (const BevelStrategy s : measured) {
     std::optional<BevelPlan> other;
     if (s != settings.strategy) {
       BevelParams geometry_only = bevel_params(settings, s);
@@ -180,7 +183,7 @@ std::expected<void, PlanJobError> measure_strategies(Run& run) {
     if (!d) return failed(PlanPhase::measuring_deviation, d.error());
     run.r.deviations.push_back({s, *d});
     run.progress.step(PlanPhase::measuring_deviation, static_cast<int>(run.r.deviations.size()),
-                       static_cast<int>(std::size(kAll)));
+                       static_cast<int>(measured.size()));
   }
   run.timing.deviation = seconds_since(t0);
   return {};

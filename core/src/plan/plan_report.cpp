@@ -32,6 +32,7 @@ ReportSettings settings_report(const PlanJobRequest& q) {
   r.strategy = bevel_strategy_name(s.strategy);
   r.layering = layering_method_name(s.layering);
   r.deviation_step_mm = s.deviation_step_mm;
+  r.compare_strategies = s.compare_strategies;
   r.axis = q.model.axis;
   if (!q.model.direction.empty()) r.direction = q.model.direction;
   r.units = q.model.units;
@@ -142,6 +143,7 @@ ReportSheet sheet_report(const SheetOutput& s, const std::vector<Part>& parts) {
   r.setup_lines = static_cast<std::int64_t>(prog.setup_lines);
   r.jet_compensation = jet_compensation_name(s.toolpath.jet_compensation);
   r.jet_tilt_limited = static_cast<std::int64_t>(s.toolpath.jet_tilt_limited);
+  if (s.toolpath.jet_corners_floored) r.jet_corners_floored = static_cast<std::int64_t>(s.toolpath.jet_corners_floored);
   for (std::size_t c = 0; c < prog.contour_lines.size(); ++c)
     r.contour_lines.push_back({static_cast<std::int64_t>(c), static_cast<std::int64_t>(prog.contour_lines[c]),
                              static_cast<std::int64_t>(prog.contour_last_cut_lines[c])});

@@ -51,8 +51,10 @@ struct Fields<ReportSettings> {
                  Field{"sub_slice_mm", &S::sub_slice_mm},     Field{"tolerance_mm", &S::tolerance_mm},
                  Field{"tilt_max_deg", &S::tilt_max_deg},     Field{"side", &S::side},
                  Field{"strategy", &S::strategy},             Field{"layering", &S::layering},
-                 Field{"deviation_step_mm", &S::deviation_step_mm}, Field{"axis", &S::axis},
+                 Field{"deviation_step_mm", &S::deviation_step_mm},
+                 Field{"compare_strategies", &S::compare_strategies}, Field{"axis", &S::axis},
                  Field{"direction", &S::direction},           Field{"units", &S::units}};
+  static constexpr bool omit_empty(std::string_view key) { return key == "compare_strategies"; }
 };
 template <>
 struct Fields<ReportShapes> {
@@ -184,8 +186,11 @@ struct Fields<ReportSheet> {
       Field{"setup_lines", &S::setup_lines},
       Field{"contour_lines", &S::contour_lines},
       Field{"jet_compensation", &S::jet_compensation},
-      Field{"jet_tilt_limited", &S::jet_tilt_limited}};
-  static constexpr bool omit_empty(std::string_view key) { return key == "slot" || key == "jet_compensation" || key == "jet_tilt_limited"; }
+      Field{"jet_tilt_limited", &S::jet_tilt_limited},
+      Field{"jet_corners_floored", &S::jet_corners_floored}};
+  static constexpr bool omit_empty(std::string_view key) {
+    return key == "slot" || key == "jet_compensation" || key == "jet_tilt_limited" || key == "jet_corners_floored";
+  }
 };
 template <>
 struct Fields<ReportAsCutFigures> {

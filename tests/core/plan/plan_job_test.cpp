@@ -51,7 +51,9 @@ PlanJobRequest request(bool with_programs) {
 
 const PlanJobResult& planned() {
   static const PlanJobResult r = [] {
-    auto p = plan_job(ball(), request(true));
+    PlanJobRequest q = request(true);
+    q.settings.compare_strategies = true;
+    auto p = plan_job(ball(), q);
     if (p) return std::move(*p);
     ADD_FAILURE() << plan_phase_name(p.error().phase) << ": " << p.error().error.message;
     return PlanJobResult{};
@@ -154,6 +156,28 @@ TEST(PlanJob, WithoutProgramsTheReportHasNoSheetsAndReadsBack) {
   EXPECT_FALSE(back->sheets);
 }
 
+// Issue 22: the strategies not chosen cost as much as the plan's own deviation, so they are
+// measured only when asked; the chosen one's figures are the same either way.
+TEST(PlanJob, TheOtherStrategiesAreMeasuredOnlyWhenAsked) {
+  PlanJobRequest q = request(false);
+  auto alone = plan_job(ball(), q);
+  ASSERT_TRUE(alone) << alone.error().error.message;
+  ASSERT_EQ(alone->report.deviation.size(), 1u);
+  EXPECT_EQ(alone->report.deviation[0].first, "curved");
+  EXPECT_EQ(alone->report.settings.compare_strategies, false);
+  q.settings.compare_strategies = true;
+  auto all = plan_job(ball(), q);
+  ASSERT_TRUE(all) << all.error().error.message;
+  ASSERT_EQ(all->report.deviation.size(), 3u);
+  EXPECT_EQ(all->report.settings.compare_strategies, true);
+  EXPECT_EQ(all->report.deviation[0].first, "vertical");
+  EXPECT_EQ(all->report.deviation[2].first, "curved");
+  EXPECT_EQ(all->report.deviation[2].second.volume_mm3, alone->report.deviation[0].second.volume_mm3);
+  EXPECT_EQ(all->report.deviation[2].second.max_mm, alone->report.deviation[0].second.max_mm);
+  const std::string text = plan_report_json(alone->report);
+  EXPECT_NE(text.find("\"compare_strategies\": false"), std::string::npos) << "the report says which";
+}
+
 TEST(PlanJob, ProgressNamesEveryPhaseInOrderAndItsStepsGrow) {
   std::vector<PlanStep> steps;
   auto r = plan_job(ball(), request(true), [&](const PlanStep& s) { steps.push_back(s); });
@@ -175,7 +199,7 @@ TEST(PlanJob, ProgressNamesEveryPhaseInOrderAndItsStepsGrow) {
     deviation_steps += s.phase == PlanPhase::measuring_deviation;
     sheet_steps += s.phase == PlanPhase::nesting_and_programs;
   }
-  EXPECT_EQ(deviation_steps, 3);
+  EXPECT_EQ(deviation_steps, 1) << "the chosen strategy only, unless compare_strategies";
   EXPECT_EQ(sheet_steps, static_cast<int>(r->cam->sheets.size()));
 }
 

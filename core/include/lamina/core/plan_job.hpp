@@ -37,6 +37,9 @@ struct PlanSettings {
   double tilt_max_rad = 0.0;
   double tilt_max_deg = 0.0;          // as given, for the report (tilt_max_rad is what is used)
   double deviation_step_mm = 0.1;
+  // The deviation of the two strategies not chosen, on the same layering: worth seeing while
+  // choosing one, and it doubles a plan's time (issue 22), so only when asked.
+  bool compare_strategies = false;
   CutSide side = CutSide::outside;
   BevelStrategy strategy = BevelStrategy::curved;
   LayeringMethod layering = LayeringMethod::optimal;
@@ -104,7 +107,9 @@ struct StrategyDeviation {
 struct PlanJobResult {
   Layering layering;
   BevelPlan plan;                             // the chosen strategy's
-  std::vector<StrategyDeviation> deviations;  // the same layering cut vertical, sloped, curved
+  // The chosen strategy's, and with compare_strategies the same layering cut the other ways too
+  // (vertical, sloped, curved order).
+  std::vector<StrategyDeviation> deviations;
   std::optional<CamResult> cam;
   std::string stack_stl;                      // binary STL of the stack
   // report.json. timing_s.write and .total cover plan_job's part; the caller adds its own

@@ -39,6 +39,9 @@ struct ReportSettings {
   double bond_mm = 0.0, sub_slice_mm = 0.0, tolerance_mm = 0.0, tilt_max_deg = 0.0;
   std::string side, strategy, layering;
   double deviation_step_mm = 0.0;
+  // false: `deviation` holds the chosen strategy's only. Absent in reports written before it
+  // (issue 22), which measured all three.
+  std::optional<bool> compare_strategies;
   std::string axis;
   std::optional<std::vector<double>> direction;
   std::string units;
@@ -150,6 +153,9 @@ struct ReportSheet {
   std::vector<ReportContour> contour_lines;
   std::optional<std::string> jet_compensation;  // what this sheet got: off, taper, full (absent before 0.8)
   std::optional<std::int64_t> jet_tilt_limited;  // its cut lines whose compensation the tilt limit held back
+  // Its lines whose corner the trail-back's corner speeds left beyond --corner-error at their
+  // slowest feed (absent when none, and before issue 20's corner work).
+  std::optional<std::int64_t> jet_corners_floored;
 };
 
 // The part as cut, beside the plan (lamina plan --as-cut; lamina/core/as_cut.hpp): both measured

@@ -96,14 +96,31 @@ struct SheetToolpath {
   // Lines of the sheet's passes (trimming passes included, cut or not) whose compensation the
   // tilt limit held back: lines planned at the limit already cannot lean further.
   std::size_t jet_tilt_limited = 0;
+  // Lines whose corner the trail-back's corner speeds could not bring within the allowance at
+  // the slowest feed they allow (JetCorners::min_fraction).
+  std::size_t jet_corners_floored = 0;
   std::vector<ToolMove> moves;  // starts with a rapid to the park position at safe height, ends with one back to it
   std::vector<ToolContour> contours;
   std::vector<Microjoint> microjoints;
   CutTime time;
 };
 
+// Which corners the trail-back's corner speeds slow down for (jet_corners.hpp). At an outside
+// corner of the part the lagging lower jet cuts into the part; at an inside one it leaves a
+// fillet of material at the bottom, which a shop may accept (or clean up) rather than pay for.
+enum class InsideCorners : std::uint8_t { slow, keep };
+const ChoiceTable<InsideCorners>& inside_corner_strategies();  // "slow", "keep"
+const char* inside_corners_name(InsideCorners s);
+
+struct JetCorners {
+  double error_mm = 0.05;      // the largest corner error of the jet's lower part allowed
+  double min_fraction = 0.1;   // of the feed: the slowest a corner is cut
+  InsideCorners inside = InsideCorners::slow;
+};
+
 struct JetCompensation {
   JetCompensationMode mode = JetCompensationMode::off;
+  JetCorners corners;  // used wherever a kerf model is (taper and full)
   std::map<std::string, KerfModel, std::less<>> kerf_by_material;  // a sheet's material must be here when on
   double tilt_max_rad = 1.0471975511965976;  // the head's limit: beyond it the line is held at it and counted
 };
