@@ -129,7 +129,8 @@ TEST(CliSheets, ProgressFdGetsOneLinePerPhaseInOrder) {
   TempDir out("progress");
   fs::create_directories(out.path);
   const fs::path file = out.path / "progress.jsonl";
-  const auto r = lamina("plan " + quoted(kKnob) + " --stock 5 --out " + quoted(out.path / "plan") +
+  // --compare-strategies: the deviation phase has three steps to show.
+  const auto r = lamina("plan " + quoted(kKnob) + " --stock 5 --compare-strategies true --out " + quoted(out.path / "plan") +
                         " --progress-fd 3 3>" + quoted(file));
   ASSERT_EQ(r.exit_code, 0) << r.out;
   std::vector<json> lines, within;  // phases as they start; steps inside a phase (issue 18)

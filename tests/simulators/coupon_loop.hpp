@@ -15,6 +15,8 @@
 #include <sstream>
 #include <string>
 
+#include <unistd.h>
+
 namespace coupon_loop {
 
 namespace fs = std::filesystem;
@@ -38,7 +40,8 @@ inline double number_after(const std::string& text, const std::string& key) {
 // The coupon cut and measured on a machine with these jet_* keys, fitted; the kerf file's text
 // and the fit's output.
 inline std::pair<std::string, std::string> calibrate_on(const std::string& name, const std::string& jet_keys) {
-  const fs::path dir = fs::temp_directory_path() / ("lamina-coupon-loop-" + name);
+  // One folder per process: ctest runs the tests that calibrate the same machine side by side.
+  const fs::path dir = fs::temp_directory_path() / ("lamina-coupon-loop-" + name + "-" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
   const std::string cli = LAMINA_CLI, sim = LAMINA_SIM, material = "'aluminium 6061-T6'";

@@ -5,9 +5,9 @@
 // With compensation the part as cut is within 25 % of the plan's own volume deviation at
 // qualities 3 and 5, and at quality 5 the deviation the jet adds (as cut − planned) is at least
 // 3x smaller than without. A second machine (a soft material's jet: reversed taper up to a faster
-// speed, less trail-back) is held to the same. Quality 1 (the separation speed) does not meet the
-// targets yet (docs/jet.md): LAMINA_JET_LOOP_QUALITIES=1,3,5 prints it too. The numbers are
-// printed for docs/jet.md.
+// speed, less trail-back) is held to the same. Quality 1 (the separation speed) is printed only
+// (LAMINA_JET_LOOP_QUALITIES=1,3,5): the hard machine meets the 25 % since the corner speeds, by a
+// hair (24.9 %), the soft one does not (docs/jet.md). The numbers are printed for docs/jet.md.
 #include "coupon_loop.hpp"
 
 #include <fmt/format.h>
@@ -105,6 +105,12 @@ void check_machine(const Machine& m, const std::vector<int>& qualities) {
 const Machine kHard{"hard", "jet_separation_mm_per_s_at_10mm = 30\njet_taper_gain = 0.04\njet_taper_offset = 0.002\n"};
 
 TEST(JetLoop, TheKnobAsCutFollowsItsPlanWithCompensation) { check_machine(kHard, qualities()); }
+
+TEST(JetLoop, OnASecondMachineToo) {
+  check_machine({"soft", "jet_separation_mm_per_s_at_10mm = 36\njet_taper_gain = 0.05\njet_taper_offset = 0.012\n"
+                         "jet_lag_max_deg = 18\njet_slow_widening = 0.3\n"},
+                qualities());
+}
 
 // examples/cross.stl: one 10 mm layer (the plan is exact: 0 %), four sharp inside corners and
 // eight outside ones. Compensated, the corners are cut at the trail-back's corner speeds
