@@ -205,6 +205,31 @@ TEST(PlanJetCompensation, ACalibratedMaterialIsCompensatedAndOffChangesNothing) 
   EXPECT_NE(r.out.find("no kerf calibration for 'aluminium 6061-T6'"), std::string::npos) << r.out;
 }
 
+// The corner flags reach the planner (jet_corners.hpp): the cross's corners at a tight
+// allowance take longer than with an allowance no corner needs, keeping the inside corners'
+// feed saves time again, and a strategy that is not one is refused naming the choices.
+TEST(PlanJetCorners, TheAllowanceAndTheInsideCornerStrategyReachThePlan) {
+  TempDir dir("plan-corners", TempDir::made);
+  std::ofstream(dir.path / "kerf.toml") << lamina::cli::kerf_toml({{"aluminium 6061-T6", {kTruth, 10, 0.01, 0.02, "al.csv"}}});
+  const std::string cross = quoted(fs::path(LAMINA_EXAMPLES_DIR) / "cross.stl") +
+                            " --stock 10 --dowels 0 --material 'aluminium 6061-T6' --kerf-file " + quoted(dir.path / "kerf.toml");
+  const auto time_s = [&](const std::string& name, const std::string& extra) {
+    const auto r = lamina_cli_test::lamina("plan " + cross + " --out " + quoted(dir.path / name) + " " + extra);
+    EXPECT_EQ(r.exit_code, 0) << r.out;
+    const auto report = nlohmann::json::parse(read_text(dir.path / name / "report.json"));
+    return report["sheets"][0]["estimated_time_s"].get<double>();
+  };
+  // kTruth's lag is 0.06 mm at the default quality: 0.01 mm is an allowance its corners slow for.
+  const double slowed = time_s("slowed", "--corner-error 0.01"), kept = time_s("kept", "--corner-error 0.01 --inside-corners keep"),
+               loose = time_s("loose", "--corner-error 10");
+  EXPECT_LT(kept, slowed) << "the four inside corners at the feed";
+  EXPECT_LT(loose, kept) << "no corner slowed at all";
+  const auto bad = lamina_cli_test::lamina("plan " + cross + " --out " + quoted(dir.path / "bad") + " --inside-corners round");
+  EXPECT_EQ(bad.exit_code, 2) << bad.out;
+  EXPECT_NE(bad.out.find("--inside-corners"), std::string::npos) << bad.out;
+  EXPECT_FALSE(fs::exists(dir.path / "bad"));
+}
+
 TEST(KerfFile, AHandEditedFileIsCheckedKeyByKey) {
   const std::string good = lamina::cli::kerf_toml({{"brass", {kTruth, 12, 0.01, 0.02, "b.csv"}}});
   auto back = lamina::cli::parse_kerf_toml(good, "kerf.toml");
