@@ -120,6 +120,8 @@ std::map<std::string, Section, std::less<>> sections() {
       {"safe_z_mm", number(0, true, 1000, "mm", 1, [](auto& c, double v) { c.cutting.safe_z_mm = v; })},
       {"min_feed_mm_per_min", number(0, true, 1e6, "mm/min", 1.0 / 60, [](auto& c, double v) { c.cutting.feed.min_feed_mm_per_s = v; })},
       {"max_feed_mm_per_min", number(0, true, 1e6, "mm/min", 1.0 / 60, [](auto& c, double v) { c.cutting.feed.max_feed_mm_per_s = v; })},
+      {"a_max_deg_per_min", number(0, true, 1e7, "degrees/min", kDeg / 60, [](auto& c, double v) { c.cutting.a_max_rad_per_s = v; })},
+      {"c_max_deg_per_min", number(0, true, 1e7, "degrees/min", kDeg / 60, [](auto& c, double v) { c.cutting.c_max_rad_per_s = v; })},
       {"park_x_mm", number(-big, false, big, "mm", 1, [](auto& c, double v) { c.cutting.park_mm.x() = v; })},
       {"park_y_mm", number(-big, false, big, "mm", 1, [](auto& c, double v) { c.cutting.park_mm.y() = v; })},
   };

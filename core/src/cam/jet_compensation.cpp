@@ -7,6 +7,8 @@
 namespace lamina::cam_detail {
 namespace {
 
+constexpr double kMinTaperLeanMm = 0.01;  // across a vertical line: below this it stays vertical
+
 // Horizontal unit direction of travel at point i (from its neighbours), or zero where the tip
 // does not move (a fan of lines at a corner turns the head about one tip).
 Eigen::Vector3d travel_at(const std::vector<PathPoint>& pts, std::size_t i, bool closed) {
@@ -46,10 +48,18 @@ std::expected<std::size_t, Error> compensate_jet(std::vector<PathPoint>& points,
     auto kerf = kerf_at(*in.kerf, path_mm, ratio);
     if (!kerf) return std::unexpected(Error{kerf.error().code, fmt::format("line {}: {}", i, kerf.error().message)});
     const Eigen::Vector3d scrap(q.scrap.x(), q.scrap.y(), 0.0);
-    q.tip += (kerf->top_width_mm / 2.0 - in.half_kerf_mm) * scrap;
-    q.bottom += (kerf->bottom_width_mm / 2.0 - in.half_kerf_mm) * scrap;
-    // The exit trails the entry by the trail-back: aim it that far ahead.
-    if (in.mode == JetCompensationMode::full) q.bottom += kerf->trail_back_mm * travel_at(planned, i, in.closed);
+    // The exit trails the entry by the trail-back: aim it that far ahead where that lag would
+    // leave more than the corner allowance. Elsewhere (straight cuts, gentle curves) a lag along
+    // the cut leaves the wall where it is, and leaning would only turn C with the path.
+    const bool lean = in.mode == JetCompensationMode::full && q.lag_beyond_allowance;
+    double top = kerf->top_width_mm / 2.0, bottom = kerf->bottom_width_mm / 2.0;
+    // A vertical line whose walls the taper moves by less than kMinTaperLeanMm stays vertical,
+    // at the mean of the two: a head tilted that little turns C at every change of direction,
+    // and the rotary rates then slow the cut for nothing (docs/jet.md).
+    if (!lean && q.axis.z() >= 1.0 - 1e-15 && std::abs(top - bottom) < kMinTaperLeanMm) top = bottom = 0.5 * (top + bottom);
+    q.tip += (top - in.half_kerf_mm) * scrap;
+    q.bottom += (bottom - in.half_kerf_mm) * scrap;
+    if (lean) q.bottom += kerf->trail_back_mm * travel_at(planned, i, in.closed);
     q.trail_back_mm = kerf->trail_back_mm;
     q.tilt_limited = hold_to_limit(q, in.tilt_max_rad, in.thickness_mm);
     held += q.tilt_limited;

@@ -97,6 +97,7 @@ std::expected<std::size_t, Error> jet_corner_speeds(std::vector<PathPoint>& pts,
     if (!full_lag) return std::unexpected(full_lag.error());
     const Window w = window_at(pts, ring, i, *full_lag);
     if (corner_error_mm(*full_lag, w.turn_rad) <= in.corners.error_mm) continue;
+    pts[i].lag_beyond_allowance = true;
     if (w.toward_scrap && in.corners.inside == InsideCorners::keep) continue;
     // The fastest fraction whose lag keeps the corner within the allowance (the error grows with
     // the lag, and the lag with the feed): bisection between the floor and the full feed.

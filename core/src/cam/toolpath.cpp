@@ -10,6 +10,7 @@
 
 #include "cam/jet_compensation.hpp"
 #include "cam/jet_corners.hpp"
+#include "cam/rotary_rates.hpp"
 #include "cam/toolpath_moves.hpp"
 #include "cam/toolpath_ring.hpp"
 
@@ -68,6 +69,8 @@ std::expected<void, Error> check_params(const ToolpathParams& p) {
     return std::unexpected(invalid(fmt::format("corner error allowance {} mm must be > 0", jc.error_mm)));
   if (!(jc.min_fraction > 0.0 && jc.min_fraction <= 1.0))
     return std::unexpected(invalid(fmt::format("jet corner slow-down floor {} must be in (0, 1]", jc.min_fraction)));
+  if (!(p.a_max_rad_per_s > 0.0) || !(p.c_max_rad_per_s > 0.0))
+    return std::unexpected(invalid(fmt::format("rotary rates A {} and C {} rad/s must be > 0", p.a_max_rad_per_s, p.c_max_rad_per_s)));
   if (!finite_at_least(p.corner_angle_rad, 0.0))
     return std::unexpected(invalid(fmt::format("corner angle {} rad must be >= 0", p.corner_angle_rad)));
   return {};
@@ -190,11 +193,12 @@ class SheetBuilder {
 
   // The jet's real kerf (JetCompensation): each line's separation speed at its tilt, the
   // material's kerf model, and the lines the tilt limit held back counted for the report.
-  std::expected<void, Error> compensate_jet(std::vector<PathPoint>& pts, const std::string& where) {
+  // Returns whether it compensated (off, or auto for an uncalibrated material, does not).
+  std::expected<bool, Error> compensate_jet(std::vector<PathPoint>& pts, const std::string& where) {
     const JetCompensation& jc = p_.jet_compensation;
-    if (jc.mode == JetCompensationMode::off) return {};
+    if (jc.mode == JetCompensationMode::off) return false;
     const auto model = jc.kerf_by_material.find(material_.name);
-    if (model == jc.kerf_by_material.end() && jc.mode == JetCompensationMode::automatic) return {};
+    if (model == jc.kerf_by_material.end() && jc.mode == JetCompensationMode::automatic) return false;
     if (model == jc.kerf_by_material.end())
       return std::unexpected(invalid(fmt::format("{}: no kerf calibration for '{}' (lamina calibrate coupon, then fit; docs/jet.md)",
                                                  where, material_.name)));
@@ -214,6 +218,26 @@ class SheetBuilder {
     auto held = cam_detail::compensate_jet(pts, separation, in);
     if (!held) return std::unexpected(Error{held.error().code, where + ", " + held.error().message});
     out_.jet_tilt_limited += *held;
+    return true;
+  }
+
+  // The jet compensation, then the rotary axes' rates (rotary_rates.hpp). Where those lower a
+  // feed under compensation, it runs again from the planned lines at the lowered feeds, so its
+  // kerf is the one at the feed the machine reaches, and the rates are held once more on the
+  // lines it gives.
+  std::expected<void, Error> compensate_within_rates(std::vector<PathPoint>& pts, const std::string& where) {
+    const std::vector<PathPoint> planned = pts;
+    const std::size_t tilt_limited = out_.jet_tilt_limited, floored = out_.jet_corners_floored;
+    auto compensated = compensate_jet(pts, where);
+    if (!compensated) return std::unexpected(compensated.error());
+    const double a_rate = p_.a_max_rad_per_s, c_rate = p_.c_max_rad_per_s;
+    if (cam_detail::limit_feeds_to_rotary_rates(pts, a_rate, c_rate) == 0 || !*compensated) return {};
+    std::vector<PathPoint> again = planned;
+    for (std::size_t i = 0; i < again.size(); ++i) again[i].feed_mm_per_s = pts[i].feed_mm_per_s;
+    out_.jet_tilt_limited = tilt_limited, out_.jet_corners_floored = floored;
+    if (auto ok = compensate_jet(again, where); !ok) return std::unexpected(ok.error());
+    cam_detail::limit_feeds_to_rotary_rates(again, a_rate, c_rate);
+    pts = std::move(again);
     return {};
   }
 
@@ -278,7 +302,7 @@ class SheetBuilder {
       passes.push_back(cam_detail::compensate_pass(outline, pass, frame, p_.part_on_right, h));
       if (auto ok = feed_points(passes.back().points, where); !ok) return ok;
       cam_detail::mark_corners(passes.back().points, p_.corner_angle_rad, p_.corner_min_fraction);
-      if (auto ok = compensate_jet(passes.back().points, where); !ok) return ok;
+      if (auto ok = compensate_within_rates(passes.back().points, where); !ok) return ok;
     }
     // Microjoints on the outer outline's freeing pass, as station parameters so every pass of the
     // outline leaves them at the same place.

@@ -39,6 +39,9 @@ struct PathPoint {
   double corner_factor = 1.0;                        // slow-down at a sharp corner of the top path
   bool tilt_limited = false;                         // jet compensation held at the head's tilt limit
   double trail_back_mm = 0.0;                        // the jet's trail-back here (jet compensation; 0 without it)
+  // The jet's lag at the full feed would leave more than the corner allowance here (a corner, a
+  // tight curve: jet_corners.hpp); only there does full compensation aim the exit ahead.
+  bool lag_beyond_allowance = false;
   // How far along the path, either side, corner_factor holds: infinite (the angle heuristic) is
   // the whole of both moves that meet here; the trail-back's corner speeds hold it for the lag.
   double slow_zone_mm = std::numeric_limits<double>::infinity();

@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <numbers>
 
 namespace lamina {
 namespace {
@@ -90,18 +91,27 @@ TEST(JetCompensation, TaperPutsThePartsWallOnThePlannedLineAtBothFaces) {
   EXPECT_EQ(tp->jet_tilt_limited, 0u);
 }
 
-TEST(JetCompensation, FullAimsTheExitAheadByTheTrailBack) {
+// Full aims the exit ahead by the trail-back only where the lag would cut across the path by more
+// than the corner allowance (the square's corners); along a straight edge a lag leaves the wall
+// where it is, and the line stays as taper puts it (a lean there would only turn C).
+TEST(JetCompensation, FullAimsTheExitAheadAtTheCornersOnly) {
   auto f = square();
   const ToolpathParams p = with(JetCompensationMode::full);
-  auto tp = plan_sheet_toolpath(f.plan, f.parts, f.sheet, aluminium(), p);
-  ASSERT_TRUE(tp) << tp.error().message;
+  auto full = plan_sheet_toolpath(f.plan, f.parts, f.sheet, aluminium(), p);
+  auto taper = plan_sheet_toolpath(f.plan, f.parts, f.sheet, aluminium(), with(JetCompensationMode::taper));
+  ASSERT_TRUE(full && taper);
   const KerfShape k = expected_kerf(p);
-  ASSERT_GT(k.trail_back_mm, 0.01);
-  for (const EdgeMove& m : edge_moves(*tp)) {
-    const Eigen::Vector3d lead = m.bottom - m.tip;
-    EXPECT_NEAR(lead.dot(m.travel), k.trail_back_mm, 1e-6) << "the bottom leads the tip along the travel";
+  ASSERT_GT(k.trail_back_mm * std::sin(std::numbers::pi / 4), p.jet_compensation.corners.error_mm) << "corners it must lean at";
+  for (const EdgeMove& m : edge_moves(*full)) {
+    EXPECT_NEAR((m.bottom - m.tip).dot(m.travel), 0.0, 1e-9) << "no lean along a straight edge";
     EXPECT_NEAR(outside_square(m.bottom), k.bottom_width_mm / 2.0, 1e-9);
   }
+  // At the corners the bottoms differ from taper's: leaned ahead.
+  ASSERT_EQ(full->moves.size(), taper->moves.size());
+  int leaned = 0;
+  for (std::size_t i = 0; i < full->moves.size(); ++i)
+    leaned += !full->moves[i].axis.isApprox(taper->moves[i].axis, 1e-9);
+  EXPECT_GE(leaned, 4) << "at least one line at each corner";
 }
 
 // The jet's lower part lags the nozzle: a ring that frees the part runs on past its start by the
@@ -130,6 +140,29 @@ TEST(JetCompensation, AFreeingRingRunsPastItsStartByTheTrailBack) {
   EXPECT_NEAR(overlap_mm(JetCompensationMode::full), k.trail_back_mm, 1e-6);
   EXPECT_NEAR(overlap_mm(JetCompensationMode::taper), k.trail_back_mm, 1e-6);
   EXPECT_EQ(overlap_mm(JetCompensationMode::off), 0.0);
+}
+
+// A vertical wall whose two faces the taper moves by less than 0.01 mm stays vertical, at the
+// mean of the two half widths: tilting the head that little would turn C at every change of
+// direction and the rotary rates would slow the cut for nothing (a 1 mm sheet's taper).
+TEST(JetCompensation, AVerticalWallTheTaperHardlyMovesStaysVertical) {
+  constexpr double thin = 1.0;
+  auto f = one_part(dev_test::make_layer(0, 0.0, thin, {dev_test::square_outline({0, 0}, kHalfSide, 0, thin)}), 0.0, kCentre, kKerfMm);
+  ToolpathParams p = with(JetCompensationMode::taper);
+  p.jet_compensation.kerf_by_material["aluminium"].taper_per_ratio = 0.01;
+  auto tp = plan_sheet_toolpath(f.plan, f.parts, f.sheet, aluminium(), p);
+  ASSERT_TRUE(tp) << tp.error().message;
+  const double feed = *cut_feed_mm_per_s(p.jet, aluminium(), p.feed, thin, 0.0);
+  const double v_s = *separation_feed_mm_per_s(p.jet, aluminium(), p.feed, thin, 0.0);
+  KerfModel model = kKerf;
+  model.taper_per_ratio = 0.01;
+  const KerfShape k = *kerf_at(model, thin, feed / v_s);
+  ASSERT_GT(std::abs(k.top_width_mm - k.bottom_width_mm), 1e-4) << "a taper, if a small one";
+  ASSERT_LT(std::abs(k.top_width_mm - k.bottom_width_mm) / 2.0, 0.01);
+  for (const ToolMove& m : tp->moves)
+    if (m.kind == MoveKind::cut) EXPECT_EQ(m.axis.z(), 1.0) << m.tip_mm.transpose();
+  for (const EdgeMove& m : edge_moves(*tp))
+    EXPECT_NEAR(outside_square(m.tip), (k.top_width_mm + k.bottom_width_mm) / 4.0, 1e-9) << "the mean half width";
 }
 
 TEST(JetCompensation, OffKeepsTheProgramByteForByte) {

@@ -17,6 +17,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <expected>
+#include <limits>
 #include <map>
 #include <span>
 #include <string>
@@ -135,6 +136,12 @@ struct ToolpathParams {
   double microjoint_width_mm = 0.6;  // uncut length of one microjoint
   double dowel_diameter_mm = 6.0;    // of the parts' dowel holes (Part::dowels_mm), cut vertical
   double rapid_mm_per_s = 250.0;
+  // The head's rotary axes' fastest rates ([motion] a_/c_max_deg_per_min; infinite: not limited).
+  // A feed that would turn A or C faster is lowered to what they reach: a controller would slow
+  // the move anyway, and the jet's kerf at the slower feed is not the one planned (a tilted jet
+  // following a curve turns C at the curvature; on thin sheets the feed is fast).
+  double a_max_rad_per_s = std::numeric_limits<double>::infinity();
+  double c_max_rad_per_s = std::numeric_limits<double>::infinity();
   // No move turns the jet's axis by more than this: a pivot head without RTCP interpolates its
   // joints, so in a move that turns the axis by θ its tip strays from the straight line by up to
   // pivot·(1 − cos θ/2) — 20 mm, through the sheet, for a lead-in from the vertical pierce to a
