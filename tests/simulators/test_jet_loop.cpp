@@ -3,11 +3,11 @@
 // planned with and without jet compensation → every sheet cut on the simulator
 // (`lamina-sim --as-cut`) → `lamina plan --as-cut` measures the part as cut beside the plan.
 // With compensation the part as cut is within 25 % of the plan's own volume deviation at
-// qualities 3 and 5, and at quality 5 the deviation the jet adds (as cut − planned) is at least
-// 3x smaller than without. A second machine (a soft material's jet: reversed taper up to a faster
-// speed, less trail-back) is held to the same. Quality 1 (the separation speed) is printed only
-// (LAMINA_JET_LOOP_QUALITIES=1,3,5): the hard machine meets the 25 % since the corner speeds, by a
-// hair (24.9 %), the soft one does not (docs/jet.md). The numbers are printed for docs/jet.md.
+// qualities 1, 3 and 5, and at quality 5 the deviation the jet adds (as cut − planned) is at
+// least 3x smaller than without. A second machine (a soft material's jet: reversed taper up to a
+// faster speed, less trail-back) is held to the same. Quality 1 met the 25 % only once the corners
+// had the trail-back's speeds and the feeds the head's rotary rates (docs/jet.md). The numbers
+// are printed for docs/jet.md.
 #include "coupon_loop.hpp"
 
 #include <fmt/format.h>
@@ -61,11 +61,11 @@ struct Machine {
   std::string name, jet_keys;
 };
 
-// The qualities to run: 3 and 5, or LAMINA_JET_LOOP_QUALITIES ("1,3,5").
+// The qualities to run: 1, 3 and 5, or LAMINA_JET_LOOP_QUALITIES ("3").
 std::vector<int> qualities() {
   const char* env = std::getenv("LAMINA_JET_LOOP_QUALITIES");
   std::vector<int> out;
-  std::stringstream list(env ? env : "3,5");
+  std::stringstream list(env ? env : "1,3,5");
   for (std::string q; std::getline(list, q, ',');) out.push_back(std::stoi(q));
   return out;
 }
@@ -87,12 +87,12 @@ void check_machine(const Machine& m, const std::vector<int>& qualities) {
       const AsCutFigures& f = by_mode[mode];
       std::printf("%s q%d %-4s: planned %.3f %% / %.3f mm, as cut %.3f %% / %.3f mm, %d of %d parts freed\n", m.name.c_str(), q,
                   mode.c_str(), f.planned_pct, f.planned_max_mm, f.as_cut_pct, f.as_cut_max_mm, f.freed, f.parts);
-      if (q > 1) EXPECT_EQ(f.freed, f.parts) << m.name << " q" << q << " " << mode << ": every part comes out of its sheet";
+      // Uncompensated at quality 1 the hard machine's lag leaves the 10 mm flange held by its bottom.
+      if (q > 1 || mode == "full") EXPECT_EQ(f.freed, f.parts) << m.name << " q" << q << " " << mode << ": every part comes out of its sheet";
       EXPECT_GT(f.parts, 0);
     }
     const AsCutFigures &off = by_mode["off"], &full = by_mode["full"];
     EXPECT_NEAR(full.planned_pct, off.planned_pct, 1e-9) << "the same plan, cut two ways";
-    if (q == 1) continue;  // printed only (see the top)
     EXPECT_LE(std::abs(full.as_cut_pct - full.planned_pct), 0.25 * full.planned_pct)
         << m.name << " q" << q << ": compensated, as cut within 25 % of the plan";
     if (q == 5)
