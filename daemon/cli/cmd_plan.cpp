@@ -8,7 +8,9 @@
 #include "plan_progress.hpp"
 #include "plan_report.hpp"
 
+#include "lamina/core/as_cut.hpp"
 #include "lamina/core/plan_job.hpp"
+#include "lamina/core/stack_mesh.hpp"
 
 #include <fmt/format.h>
 
@@ -56,9 +58,10 @@ std::vector<std::string> model_warnings(const PlanSettings& settings, const Mesh
   return w;
 }
 
-// Sheet files of an earlier run that this run does not rewrite must not be mistaken for its own.
+// Sheet files (and an as-cut mesh) of an earlier run that this run does not rewrite must not be
+// mistaken for its own.
 bool is_sheet_file(const std::string& name) {
-  return name.starts_with("sheet-") && (name.ends_with(".nc") || name.ends_with(".svg"));
+  return (name.starts_with("sheet-") && (name.ends_with(".nc") || name.ends_with(".svg"))) || name == "as-cut.stl";
 }
 
 // Every file is made in memory first: a failure anywhere writes nothing. Returns 0 or 1.
@@ -68,6 +71,8 @@ int write_plan(const PlanOptions& o, PlanJobResult& r, PlanProgress& progress, C
   auto out = StagedOutput::open(o.out_dir);
   if (!out) return report_error(out.error());
   if (auto w = out->stage("stack.stl", r.stack_stl); !w) return report_error(w.error());
+  if (!r.as_cut_stl.empty())
+    if (auto w = out->stage("as-cut.stl", r.as_cut_stl); !w) return report_error(w.error());
   if (r.cam)
     for (const SheetOutput& s : r.cam->sheets)
       for (const auto& [name, bytes] : {std::pair{s.program_name, &s.program.text}, std::pair{s.svg_name, &s.svg}})
@@ -90,6 +95,7 @@ int add_as_cut(const std::string& dir, const Mesh& mesh, PlanJobResult& r) {
   auto d = measure_as_cut(mesh, r.plan, r.cam->parts, sheets, *cut, AsCutParams{});
   if (!d) return report_error(d.error());
   r.report.as_cut = report_as_cut(*d, dir);
+  r.as_cut_stl = binary_stl_bytes(as_cut_mesh(d->slabs), "lamina as cut, measured from " + fs::path(dir).filename().string());
   return 0;
 }
 
@@ -106,6 +112,7 @@ void print_plan(const PlanOptions& o, const PlanJobResult& r) {
       print_as_cut_table(stdout, *r.report.as_cut, o.all_rows);
     }
     fmt::print("wrote {} ({} bytes), {}", (dir / "stack.stl").string(), r.stack_stl.size(), (dir / "report.json").string());
+    if (!r.as_cut_stl.empty()) fmt::print(", {} (the parts as cut)", (dir / "as-cut.stl").string());
     if (r.cam && !r.cam->sheets.empty())
       fmt::print(", and {} program(s) + drawing(s) {}/sheet-<n>.nc, .svg", r.cam->sheets.size(), dir.string());
     fmt::print("\n");

@@ -51,6 +51,8 @@ AsCutFigures cut_the_model(const std::string& model, const fs::path& dir, const 
   out = run(plan + " --out " + (dir / "measured").string() + " --as-cut " + (dir / "plan").string() + " > /dev/null");
   const nlohmann::json measured = read_json(dir / "measured" / "report.json");
   EXPECT_TRUE(measured.contains("as_cut")) << out;
+  EXPECT_GT(fs::exists(dir / "measured" / "as-cut.stl") ? fs::file_size(dir / "measured" / "as-cut.stl") : 0u, 84u)
+      << "the parts as cut, as a mesh";
   if (!measured.contains("as_cut")) return {};
   const auto& a = measured["as_cut"];
   return {a["planned"]["volume_pct"], a["as_cut"]["volume_pct"], a["planned"]["max_mm"], a["as_cut"]["max_mm"],

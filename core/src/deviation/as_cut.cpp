@@ -66,6 +66,7 @@ double intersection_mm2(const ClipperLib::Paths& a, const ClipperLib::Paths& b) 
 struct Slab {
   std::size_t layer_slot = 0;
   double z_mm = 0.0, height_mm = 0.0;
+  double z_bottom_mm = 0.0, z_top_mm = 0.0;
   std::vector<Polygon2> as_cut, planned;
 };
 
@@ -199,7 +200,7 @@ std::vector<Slab> slabs_of(const BevelPlan& plan, std::size_t slot, const LayerG
     const double from = k == 0 ? 0.0 : 0.5 * (g.depths_mm[k - 1] + g.depths_mm[k]);
     const double to = k + 1 == n ? layer.thickness_mm : 0.5 * (g.depths_mm[k] + g.depths_mm[k + 1]);
     const double z = layer.z_top_mm() - g.depths_mm[k];
-    out.push_back({slot, z, to - from, united(g.as_cut[k]), layer_section(layer, z)});
+    out.push_back({slot, z, to - from, layer.z_top_mm() - to, layer.z_top_mm() - from, united(g.as_cut[k]), layer_section(layer, z)});
   }
   return out;
 }
@@ -300,6 +301,7 @@ std::expected<AsCutDeviation, Error> measure_as_cut(const Mesh& mesh, const Beve
   // Summed in slab order: the totals do not depend on threads.
   std::map<std::size_t, LayerAsCut> by_layer;
   for (std::size_t i = 0; i < slabs.size(); ++i) {
+    d.slabs.push_back({plan.layers[slabs[i].layer_slot].index, slabs[i].z_bottom_mm, slabs[i].z_top_mm, slabs[i].as_cut});
     LayerAsCut& l = by_layer[slabs[i].layer_slot];
     add_slab(l.as_cut, l.model_volume_mm3, slabs[i], measures[i], true);
     double unused = 0.0;

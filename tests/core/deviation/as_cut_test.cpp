@@ -120,3 +120,43 @@ TEST(AsCutDeviation, APartMissingAtADepthIsSaidAndTheSheetMustMatch) {
 
 }  // namespace
 }  // namespace lamina
+
+namespace lamina {
+namespace {
+
+double signed_volume_mm3(const TriangleSoup& soup) {
+  double v = 0.0;
+  for (std::size_t i = 0; i + 2 < soup.corners.size(); i += 3)
+    v += soup.corners[i].cast<double>().dot(soup.corners[i + 1].cast<double>().cross(soup.corners[i + 2].cast<double>())) / 6.0;
+  return v;
+}
+
+// `lamina plan --as-cut` writes the parts as cut as as-cut.stl: a stack of closed prisms, one per
+// slab, in the build frame, holes and all, the volume the sections enclose.
+TEST(AsCutMesh, EverySlabIsAClosedPrismOfItsSectionInTheBuildFrame) {
+  const BoxSheet s = box_on_a_sheet();
+  CutSheet cut = cut_sheet(s, 0.1);
+  Polygon2 hole;  // a 3 mm square hole at 5..8 in the layer's frame, clockwise
+  for (const Eigen::Vector2d& c : {Eigen::Vector2d(5, 5), Eigen::Vector2d(5, 8), Eigen::Vector2d(8, 8), Eigen::Vector2d(8, 5)})
+    hole.push_back(Eigen::Rotation2Dd(s.sheet.placements[0].rotation_rad) * c + s.sheet.placements[0].offset_mm);
+  for (CutSection& section : cut.sections) section.pieces[0].rings.push_back(hole);
+  auto d = measure_as_cut(s.mesh, s.plan, s.parts, {&s.sheet, 1}, {&cut, 1}, AsCutParams{});
+  ASSERT_TRUE(d) << d.error().message;
+  ASSERT_EQ(d->slabs.size(), 4u);
+  const TriangleSoup all = as_cut_mesh(d->slabs);
+  EXPECT_NEAR(signed_volume_mm3(all), (19.8 * 19.8 - 9.0) * 10.0, 1e-2);
+  for (const AsCutSlab& slab : d->slabs) {
+    EXPECT_NEAR(slab.z_top_mm - slab.z_bottom_mm, 2.5, 1e-9);
+    const TriangleSoup one = as_cut_mesh({&slab, 1});
+    const Mesh m = mesh_test::build_checked(one);
+    EXPECT_TRUE(m.summary.watertight) << "every edge twice, consistently wound";
+    EXPECT_NEAR(signed_volume_mm3(one), (19.8 * 19.8 - 9.0) * 2.5, 1e-2) << "facing outward as written";
+    for (const Eigen::Vector3d& v : m.vertices) {
+      EXPECT_GE(v.x(), 0.1 - 1e-4);  // the build frame: the box's 0..20, not the sheet's 200..
+      EXPECT_LE(v.x(), 19.9 + 1e-4);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace lamina

@@ -18,6 +18,7 @@
 #include "lamina/core/nest.hpp"
 #include "lamina/core/parts.hpp"
 #include "lamina/core/polygon.hpp"
+#include "lamina/core/triangle_soup.hpp"
 
 #include <Eigen/Core>
 
@@ -65,8 +66,16 @@ struct LayerAsCut {
   int parts = 0, parts_freed = 0;  // a part not freed: no piece of it at some depth (a microjoint, a cut that did not go through)
 };
 
+// One slab of a layer as cut: the parts' pieces at one depth, mapped into the build frame.
+struct AsCutSlab {
+  int layer = 0;                              // LayerPlan::index
+  double z_bottom_mm = 0.0, z_top_mm = 0.0;   // the depth stands for this much of the layer
+  std::vector<Polygon2> rings;                // build frame: outers counter-clockwise, holes clockwise
+};
+
 struct AsCutDeviation {
   std::vector<LayerAsCut> layers;  // every layer with a sheet measured, in plan order
+  std::vector<AsCutSlab> slabs;    // what was measured, layer by layer, top down
   double model_volume_mm3 = 0.0;
   VolumeAndDistance planned, as_cut;
   int parts = 0, parts_freed = 0;
@@ -79,5 +88,10 @@ std::expected<AsCutDeviation, Error> measure_as_cut(const Mesh& mesh, const Beve
                                                     std::span<const Part> parts,
                                                     std::span<const NestedSheet> sheets,
                                                     std::span<const CutSheet> cut, const AsCutParams& params);
+
+// The parts as cut as a triangle mesh in the build frame, to load beside the model and the
+// planned stack: every slab a closed prism of its rings (walls, and caps on exactly the ring
+// vertices), stepped from slab to slab as the sections are.
+TriangleSoup as_cut_mesh(std::span<const AsCutSlab> slabs);
 
 }  // namespace lamina

@@ -112,6 +112,7 @@ struct PlanJobResult {
   std::vector<StrategyDeviation> deviations;
   std::optional<CamResult> cam;
   std::string stack_stl;                      // binary STL of the stack
+  std::string as_cut_stl;                     // binary STL of the parts as cut (lamina plan --as-cut; empty without)
   // report.json. timing_s.write and .total cover plan_job's part; the caller adds its own
   // writing and reading to them.
   PlanReport report;
