@@ -59,17 +59,13 @@ struct Window {
   bool toward_scrap = false;  // its net turn is towards the scrap side: an inside corner of the part
 };
 
-Window window_at(const std::vector<PathPoint>& pts, const TurnRing& r, std::size_t i, double lag_mm) {
+// The scrap lies left of the travel when the part is on the jet's right (ToolpathParams::part_on_right).
+Window window_at(const TurnRing& r, std::size_t i, double lag_mm, bool scrap_left) {
   double total = 0.0, net = 0.0;
   for_each_within(r, i, lag_mm, [&](std::size_t j, double) {
     total += std::abs(r.turn_rad[j]);
     net += r.turn_rad[j];
   });
-  // The scrap lies to the left of the travel when it is on the left normal's side.
-  const std::size_t n = pts.size();
-  const Eigen::Vector2d travel = pts[(i + 1) % n].tip.head<2>() - pts[(i + n - 1) % n].tip.head<2>();
-  const Eigen::Vector2d left(-travel.y(), travel.x());
-  const bool scrap_left = left.dot(pts[i].scrap) > 0.0;
   return {std::min(total, std::numbers::pi), net != 0.0 && (net > 0.0) == scrap_left};
 }
 
@@ -95,7 +91,7 @@ std::expected<std::size_t, Error> jet_corner_speeds(std::vector<PathPoint>& pts,
     };
     const auto full_lag = lag_at(full_ratio);
     if (!full_lag) return std::unexpected(full_lag.error());
-    const Window w = window_at(pts, ring, i, *full_lag);
+    const Window w = window_at(ring, i, *full_lag, in.part_on_right);
     if (corner_error_mm(*full_lag, w.turn_rad) <= in.corners.error_mm) continue;
     pts[i].lag_beyond_allowance = true;
     if (w.toward_scrap && in.corners.inside == InsideCorners::keep) continue;
@@ -105,7 +101,7 @@ std::expected<std::size_t, Error> jet_corner_speeds(std::vector<PathPoint>& pts,
     const auto fits = [&](double fraction) -> std::expected<bool, Error> {
       auto lag = lag_at(fraction * full_ratio);
       if (!lag) return std::unexpected(lag.error());
-      return corner_error_mm(*lag, window_at(pts, ring, i, *lag).turn_rad) <= in.corners.error_mm;
+      return corner_error_mm(*lag, window_at(ring, i, *lag, in.part_on_right).turn_rad) <= in.corners.error_mm;
     };
     auto floor_fits = fits(lo);
     if (!floor_fits) return std::unexpected(floor_fits.error());

@@ -22,6 +22,7 @@ struct JetCornerInput {
   const KerfModel* kerf = nullptr;
   double thickness_mm = 0.0;
   JetCorners corners;  // the allowance, the floor and the inside-corner strategy
+  bool part_on_right = true;  // the path's side convention (ToolpathParams): the scrap is on the other
 };
 
 // Sets corner_factor and slow_zone_mm of every point of the closed path `points` (their feeds

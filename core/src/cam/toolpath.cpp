@@ -211,7 +211,7 @@ class SheetBuilder {
     const JetCompensationMode mode = jc.mode == JetCompensationMode::automatic ? JetCompensationMode::full : jc.mode;
     out_.jet_compensation = mode;
     // The corners' speeds first: the compensation reads each line's feed ratio, slow-down included.
-    auto floored = cam_detail::jet_corner_speeds(pts, separation, {&model->second, sheet_.thickness_mm, jc.corners});
+    auto floored = cam_detail::jet_corner_speeds(pts, separation, {&model->second, sheet_.thickness_mm, jc.corners, p_.part_on_right});
     if (!floored) return std::unexpected(Error{floored.error().code, where + ", " + floored.error().message});
     out_.jet_corners_floored += *floored;
     const cam_detail::JetCompensationInput in{mode, &model->second, sheet_.thickness_mm, 0.5 * p_.kerf_mm, jc.tilt_max_rad, true};
