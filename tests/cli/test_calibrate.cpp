@@ -223,6 +223,11 @@ TEST(PlanJetCorners, TheAllowanceAndTheInsideCornerStrategyReachThePlan) {
   const double slowed = time_s("slowed", "--corner-error 0.01"), kept = time_s("kept", "--corner-error 0.01 --inside-corners keep"),
                loose = time_s("loose", "--corner-error 10");
   EXPECT_LT(kept, slowed) << "the four inside corners at the feed";
+  // The report says what the corners were cut with, and the head's rates (config/machine.toml).
+  const auto report = nlohmann::json::parse(read_text(dir.path / "kept" / "report.json"));
+  EXPECT_EQ(report["cam"]["corner_error_mm"], 0.01);
+  EXPECT_EQ(report["cam"]["inside_corners"], "keep");
+  EXPECT_NEAR(report["cam"]["c_max_deg_per_min"].get<double>(), 7200.0, 1e-6);
   EXPECT_LT(loose, kept) << "no corner slowed at all";
   const auto bad = lamina_cli_test::lamina("plan " + cross + " --out " + quoted(dir.path / "bad") + " --inside-corners round");
   EXPECT_EQ(bad.exit_code, 2) << bad.out;

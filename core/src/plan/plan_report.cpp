@@ -3,6 +3,7 @@
 
 #include <fmt/format.h>
 
+#include <cmath>
 #include <map>
 #include <numbers>
 
@@ -92,6 +93,11 @@ ReportCam cam_report(const CamSettings& s, const CamResult& r) {
   c.head = ReportHead{m.head.pivot_mm, m.head.a_sign, m.head.c_sign, m.head.c_offset_rad / kDeg};
   c.jet_compensation = jet_compensation_name(m.cutting.jet_compensation.mode);
   if (!s.kerf_source.empty()) c.kerf_file = s.kerf_source;
+  c.corner_error_mm = m.cutting.jet_compensation.corners.error_mm;
+  c.inside_corners = inside_corners_name(m.cutting.jet_compensation.corners.inside);
+  const auto per_min = [](double rad_per_s) { return std::isfinite(rad_per_s) ? std::optional(rad_per_s * 60.0 / kDeg) : std::nullopt; };
+  c.a_max_deg_per_min = per_min(m.cutting.a_max_rad_per_s);
+  c.c_max_deg_per_min = per_min(m.cutting.c_max_rad_per_s);
   c.feed_model = feed_model_name(m.cutting.feed.model);
   c.quality = m.cutting.feed.quality;
   c.kerf_mm = m.cutting.kerf_mm;

@@ -136,8 +136,13 @@ struct Fields<ReportCam> {
       Field{"lead_out_mm", &S::lead_out_mm},   Field{"pierce_dwell_s", &S::pierce_dwell_s}, Field{"microjoints", &S::microjoints},
       Field{"microjoint_width_mm", &S::microjoint_width_mm}, Field{"dowels", &S::dowels},
       Field{"dowel_diameter_mm", &S::dowel_diameter_mm},     Field{"parts", &S::parts},
-      Field{"timing_s", &S::timing_s}, Field{"jet_compensation", &S::jet_compensation}, Field{"kerf_file", &S::kerf_file}};
-  static constexpr bool omit_empty(std::string_view key) { return key == "head" || key == "jet_compensation" || key == "kerf_file"; }
+      Field{"timing_s", &S::timing_s}, Field{"jet_compensation", &S::jet_compensation}, Field{"kerf_file", &S::kerf_file},
+      Field{"corner_error_mm", &S::corner_error_mm}, Field{"inside_corners", &S::inside_corners},
+      Field{"a_max_deg_per_min", &S::a_max_deg_per_min}, Field{"c_max_deg_per_min", &S::c_max_deg_per_min}};
+  static constexpr bool omit_empty(std::string_view key) {
+    return key == "head" || key == "jet_compensation" || key == "kerf_file" || key == "corner_error_mm" ||
+           key == "inside_corners" || key == "a_max_deg_per_min" || key == "c_max_deg_per_min";
+  }
 };
 template <>
 struct Fields<ReportPart> {

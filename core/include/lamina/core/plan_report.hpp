@@ -104,6 +104,10 @@ struct ReportCam {
   bool rtcp = false;
   std::optional<ReportHead> head;  // absent in reports written before it (0.7.0 and older)
   std::optional<std::string> jet_compensation, kerf_file;  // as asked ("auto"…), and the calibrations' file; absent before 0.8
+  // The trail-back's corner speeds (--corner-error, --inside-corners) and the head's rotary rates
+  // (degrees/min; absent when not limited): absent in reports written before issue 20's corners.
+  std::optional<double> corner_error_mm, a_max_deg_per_min, c_max_deg_per_min;
+  std::optional<std::string> inside_corners;
   std::string feed_model;
   std::int64_t quality = 0;
   double kerf_mm = 0.0, lead_in_mm = 0.0, lead_out_mm = 0.0, pierce_dwell_s = 0.0;
