@@ -128,6 +128,30 @@ std::size_t Machine::queued_timed_blocks() const {
   return static_cast<std::size_t>(queued) + (running_ && occupies_planner(running_->block) ? 1 : 0);
 }
 std::size_t Machine::planner_blocks() const { return config_.planner_blocks; }
+double Machine::motion_ahead_s(double now_s) const {
+  double ahead_s = 0;
+  if (running_) ahead_s = std::max(0.0, phase_end_s(*running_) - now_s);
+  for (const auto& b : queue_) ahead_s += b.duration_s;
+  return ahead_s;
+}
+double Machine::time_until_blocks_left(double now_s, std::size_t blocks) const {
+  std::size_t left = queued_timed_blocks();
+  if (left <= blocks) return 0;
+  double until_s = 0;
+  if (running_ && occupies_planner(running_->block)) {
+    until_s = std::max(0.0, phase_end_s(*running_) - now_s);
+    if (--left <= blocks) return until_s;
+  }
+  for (const auto& b : queue_) {
+    until_s += b.duration_s;
+    if (occupies_planner(b) && --left <= blocks) break;
+  }
+  return until_s;
+}
+bool Machine::runs_on_host_lines() const {
+  return running_ && running_->phase == Phase::cruise && program_running_ && !held_ && !alarm_ &&
+         !draining_for_sync_ && !dwelling();
+}
 
 double Machine::fraction_at(const Running& r, double now_s) const {
   const double dt = std::max(0.0, now_s - r.seg_t0_s);

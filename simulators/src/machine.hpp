@@ -123,6 +123,14 @@ class Machine {
   std::size_t queued_blocks() const;        // every queued line, zero-time ones and the running one included
   std::size_t queued_timed_blocks() const;  // the ones that occupy the planner (motion; not a dwell)
   std::size_t planner_blocks() const;       // the configured capacity ($I)
+  // Simulated seconds of planned motion still to run: the running block's rest and every
+  // queued block's duration (infinite in a hold: nothing runs down).
+  double motion_ahead_s(double now_s) const;
+  // Simulated seconds until at most `blocks` timed blocks are left (0 if there are no more now).
+  double time_until_blocks_left(double now_s, std::size_t blocks) const;
+  // The program is moving and only lines the host has not sent yet keep it going: a block runs,
+  // no hold, no alarm, no dwell, and no sync (jet change, program end) is waiting for the drain.
+  bool runs_on_host_lines() const;
 
   // Run the time model up to now_s: finish blocks, start the next ones, emit events.
   void advance(double now_s);

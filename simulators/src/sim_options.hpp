@@ -5,6 +5,7 @@
 #include <string>
 
 #include "grbl_protocol.hpp"
+#include "host_pacer.hpp"
 #include "jet_head.hpp"
 #include "jet_physics.hpp"
 #include "machine.hpp"
@@ -47,6 +48,7 @@ struct SimOptions {
   std::string log_path;
   double baud = 115200;
   double time_scale = 1;
+  bool pace_to_host = false;  // --pace-to-host (host_pacer.hpp): real time while the host falls behind
   OnOpen on_open = OnOpen::quiet;
   MachineConfig machine;
   // The head (head_* keys of the machine file): with it, the execution log says where the jet's

@@ -65,7 +65,8 @@ SimRuntime::SimRuntime(SimOptions options)
       tx_pacer_(options_.baud / 10.0, kBurstS),
       log_(options_.log_path, options_.head),
       plc_(options_.plc),
-      garble_rng_(options_.faults.garble_seed) {
+      garble_rng_(options_.faults.garble_seed),
+      scale_asked_(options_.time_scale) {
   if (!(options_.baud > 0)) throw std::runtime_error("--baud must be positive");
   if (!(options_.time_scale > 0)) throw std::runtime_error("--time-scale must be positive");
   protocol_ = make_protocol(options_, machine_);
@@ -123,7 +124,7 @@ void SimRuntime::run(const std::atomic<bool>& stop) {
 
 void SimRuntime::step() {
   const double wall = wall_s();
-  const double now = clock_.sim_at(wall);
+  const double now = sim_at_with_knee(wall);
 
   switch (port_->update()) {
     case PortChange::client_connected:
@@ -158,6 +159,7 @@ void SimRuntime::step() {
     log_.write_event("stall_end", now);
   }
   protocol_->poll(now);
+  pace_to_host(now);
   tick_plc(now);
   for (const auto& event : machine_.take_events()) log_.write(event);
   log_jet_and_state(now);
@@ -369,13 +371,49 @@ void SimRuntime::apply_schedule(double wall, double now) {
   }
 }
 
+double SimRuntime::sim_at_with_knee(double wall) {
+  if (pace_knee_ && clock_.sim_at(wall) > *pace_knee_->slow_from_s) {
+    const PaceDecision knee = *pace_knee_;
+    pace_knee_.reset();
+    pacer_.slowed_at_knee();
+    log_.write_event("time_scale", *knee.slow_from_s, {{"from", clock_.scale()}, {"to", knee.slow_scale}, {"paced", true}});
+    std::lock_guard lock(plc_mutex_);
+    plc_.rescale_watchdog(*knee.slow_from_s, knee.slow_scale / clock_.scale());
+    clock_.set_scale_from(*knee.slow_from_s, knee.slow_scale);
+  }
+  return clock_.sim_at(wall);
+}
+
+void SimRuntime::pace_to_host(double now) {
+  if (!options_.pace_to_host) return;
+  const std::size_t capacity = machine_.planner_blocks();
+  const ControllerLead lead{machine_.motion_ahead_s(now), machine_.time_until_blocks_left(now, capacity / 2),
+                            machine_.queued_timed_blocks(), capacity};
+  const PaceDecision d = pacer_.decide(now, lead, machine_.runs_on_host_lines(), scale_asked_);
+  if (d.scale != clock_.scale()) change_scale(now, d.scale, "paced");
+  pace_knee_.reset();
+  if (d.slow_from_s && d.slow_scale != d.scale) pace_knee_ = d;
+}
+
+void SimRuntime::change_scale(double now, double to, const char* reason) {
+  const double from = clock_.scale();
+  nlohmann::json fields{{"from", from}, {"to", to}};
+  if (std::string_view(reason) == "paced") fields["paced"] = true;
+  log_.write_event("time_scale", now, fields);
+  std::lock_guard lock(plc_mutex_);
+  clock_.set_scale(to);
+  plc_.rescale_watchdog(now, to / from);
+}
+
 nlohmann::json SimRuntime::status_json() const {
   const double now = sim_s();
   const auto& c = protocol_->counters();
   nlohmann::json pos = nlohmann::json::array();
   for (double v : machine_.position(now)) pos.push_back(v);
   return {{"t", now},
-          {"time_scale", clock_.scale()},
+          {"time_scale", scale_asked_},
+          {"time_scale_now", clock_.scale()},
+          {"paced_slowdowns", pacer_.slowdowns()},
           {"state", state_name(machine_.state())},
           {"position", pos},
           {"accepted_blocks", machine_.accepted_blocks()},
@@ -404,11 +442,9 @@ std::optional<std::string> SimRuntime::clock_or_network_command(const std::strin
   if (verb == "time-scale") {
     const double k = std::stod(arg);
     if (!(k > 0 && k <= 1000)) return "error: time-scale K needs a factor in (0, 1000]";
-    const double from = clock_.scale();
-    log_.write_event("time_scale", now, {{"from", from}, {"to", k}});
-    std::lock_guard lock(plc_mutex_);
-    clock_.set_scale(k);
-    plc_.rescale_watchdog(now, k / from);
+    scale_asked_ = k;
+    pace_knee_.reset();
+    change_scale(now, k, "control");
     return "ok";
   }
   if (verb == "plc" && (arg == "down" || arg == "up")) {

@@ -18,6 +18,7 @@
 #include "cnc_protocol.hpp"
 #include "control_socket.hpp"
 #include "exec_log.hpp"
+#include "host_pacer.hpp"
 #include "machine.hpp"
 #include "modbus_server.hpp"
 #include "plc.hpp"
@@ -51,6 +52,9 @@ class SimRuntime {
   void apply_schedule(double wall, double now);
   void unplug(double now, const std::string& why);
   std::string handle_command(const std::string& line);
+  void pace_to_host(double now);            // after the controller took its lines: the clock's next rate
+  double sim_at_with_knee(double wall);     // the clock at `wall`, a pacing knee passed on the way applied
+  void change_scale(double now, double to, const char* reason);  // logged; the PLC's watchdog follows
   std::optional<std::string> clock_or_network_command(const std::string& verb, const std::string& arg, double now);
   nlohmann::json status_json() const;
 
@@ -79,6 +83,9 @@ class SimRuntime {
   std::uint64_t unplugs_ = 0;
   bool jet_flowing_ = false;                 // as last logged ("jet" events)
   std::string logged_state_ = "idle";        // as last logged ("state" events)
+  HostPacer pacer_;
+  double scale_asked_ = 1;                 // --time-scale or control `time-scale K`: the pacer's ceiling
+  std::optional<PaceDecision> pace_knee_;  // slow down at this simulated instant
   std::uint64_t line_ends_in_ = 0;  // LF bytes that reached the controller (for --unplug-at-line)
 };
 

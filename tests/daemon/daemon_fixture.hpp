@@ -38,13 +38,15 @@ inline double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-// The simulated cell, fast: 20× time, 921600 baud (the link is not what these tests measure).
+// The simulated cell, fast: 20× time, 921600 baud (the link is not what these tests measure),
+// paced to the host (--pace-to-host): real time while the daemon falls behind, so a sanitized
+// daemon's pause on a loaded machine is not taken for a daemon too slow for a real one.
 struct Cell {
   explicit Cell(std::vector<std::string> extra = {}, double time_scale = 20)
       : sim([&] {
           std::vector<std::string> args{"--link", dir.file("cnc"), "--modbus", "127.0.0.1:0", "--control", "127.0.0.1:0",
                                         "--log", dir.file("exec.jsonl"), "--pressure-ramp", "0.2", "--baud", "921600",
-                                        "--time-scale", fmt::format("{}", time_scale), "--heartbeat-timeout", "1000",
+                                        "--time-scale", fmt::format("{}", time_scale), "--pace-to-host", "--heartbeat-timeout", "1000",
                                         "--machine", std::string(LAMINA_SOURCE_DIR) + "/config/sim-machine.toml"};
           args.insert(args.end(), extra.begin(), extra.end());
           return args;

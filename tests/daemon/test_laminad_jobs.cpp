@@ -49,7 +49,8 @@ std::string cut_sheet_one_of_the_knob(RpcClient& c, const Cell& cell, const Lami
   call_ok(c, "job.confirm_sheet", {{"job", id}, {"sheet", 1}});
   const bool cutting = sim::testing::wait_status(
       cell.sim.control_port(), [blocks](const Json& s) { return s["executed_blocks"] > blocks; }, 60);
-  EXPECT_TRUE(cutting) << "the CNC never got to block " << blocks;
+  EXPECT_TRUE(cutting) << "the CNC never got to block " << blocks << ": "
+                       << sim::testing::control_status(cell.sim.control_port()).dump() << daemon.log();
   return cutting ? id : std::string();
 }
 
@@ -103,6 +104,9 @@ TEST(LaminadJobs, SubmittedModelIsPlannedAndEverySheetCutLineForLine) {
   // The cell is left safe: jet, abrasive and pump off.
   const Json st = call_ok(c, "machine.status");
   EXPECT_EQ(st["cell"]["jet_is_on"], false);
+  const Json sim_status = sim::testing::control_status(cell.sim.control_port());
+  EXPECT_EQ(sim_status["starvation"], 0);
+  RecordProperty("paced_slowdowns", sim_status["paced_slowdowns"].dump());
 }
 
 // Through the client as the operator types it: `lamina hold`, `lamina status`, `lamina resume`.
