@@ -137,7 +137,9 @@ int run_plan(const PlanOptions& o, const CamOptions& cam_options) {
   PlanProgress progress(o.progress_fd, request.cam ? 7 : 5);
 
   progress.phase("reading the model");
-  auto model = load_model(o.model);
+  ModelOptions model_options = o.model;
+  if (!model_options.chord_tolerance_mm) model_options.chord_tolerance_mm = o.tolerance_mm / 10;
+  auto model = load_model(model_options);
   if (!model) return report_error(model.error());
   const Mesh& mesh = model->mesh;
   if (!mesh.usable())

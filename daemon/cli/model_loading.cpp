@@ -1,11 +1,17 @@
 #include "model_loading.hpp"
 
 #include "lamina/core/mesh_io.hpp"
+#if LAMINA_HAVE_STEP
+#include "lamina/step/cad_reader.hpp"
+#endif
 #include "lamina/core/slice.hpp"
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <cctype>
 #include <chrono>
+#include <filesystem>
 #include <numbers>
 
 namespace lamina::cli {
@@ -25,21 +31,52 @@ MeshParams mesh_params_from(const ModelOptions& o) {
   return p;
 }
 
+bool is_cad_path(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext == ".step" || ext == ".stp" || ext == ".iges" || ext == ".igs";
+}
+
+namespace {
+
+std::expected<TriangleSoup, Error> read_cad(const ModelOptions& options) {
+  if (options.units != "mm")
+    return std::unexpected(Error{ErrorCode::invalid_argument,
+                                 fmt::format("{}: a STEP or IGES file names its own units: --units is for meshes", options.path)});
+#if LAMINA_HAVE_STEP
+  CadReadOptions cad;
+  cad.quote_file_text = !options.no_quote_input;
+  if (options.chord_tolerance_mm) cad.chord_tolerance_mm = *options.chord_tolerance_mm;
+  return read_cad_file(options.path, cad);
+#else
+  return std::unexpected(Error{ErrorCode::unsupported,
+                               fmt::format("{}: this lamina was built without STEP support (OpenCASCADE was not found "
+                                           "at build time: scripts/setup installs it); export the part as STL or 3MF",
+                                           options.path)});
+#endif
+}
+
+}  // namespace
+
 std::expected<LoadedModel, Error> load_model(const ModelOptions& options) {
   LoadedModel out;
   auto t0 = std::chrono::steady_clock::now();
   MeshReadOptions read_options;
   read_options.quote_file_text = !options.no_quote_input;
-  auto soup = read_mesh_file(options.path, read_options);
+  auto soup = is_cad_path(options.path) ? read_cad(options) : read_mesh_file(options.path, read_options);
   out.read_s = seconds_since(t0);
   if (!soup) return std::unexpected(soup.error());
   out.format = soup->format;
   out.notes = soup->notes;
+  if (soup->brep) {
+    out.brep = BrepData{{}, {}, soup->brep->faces, soup->brep->solids, soup->brep->length_unit};
+  }
   t0 = std::chrono::steady_clock::now();
   auto mesh = build_mesh(*soup, mesh_params_from(options));
   out.topology_s = seconds_since(t0);
   if (!mesh) return std::unexpected(mesh.error());
   out.mesh = std::move(*mesh);
+  if (options.surface_normals == "facet") out.mesh.corner_normals.clear();
   return out;
 }
 

@@ -19,10 +19,17 @@ struct ModelOptions {
   // --no-quote-input: reader messages describe the file's bytes instead of quoting them (laminad
   // plans files its clients name; MeshReadOptions::quote_file_text).
   bool no_quote_input = false;
+  // STEP / IGES only: the tessellation's chord tolerance (mm). Unset: `lamina plan` takes a tenth
+  // of its --tolerance, check and slice CadReadOptions' default (0.02 mm).
+  std::optional<double> chord_tolerance_mm;
+  // STEP / IGES only: "exact" (the bevel plan reads the B-rep surface's normal) or "facet" (the
+  // triangles' own, as for a mesh; to measure what the exact ones change).
+  std::string surface_normals = "exact";
 };
 
 struct LoadedModel {
   std::string format;
+  std::optional<BrepData> brep;  // a STEP / IGES file's faces and solids (without the per-triangle tables)
   std::vector<ReadNote> notes;
   Mesh mesh;
   double read_s = 0.0;
@@ -30,6 +37,8 @@ struct LoadedModel {
 };
 
 MeshParams mesh_params_from(const ModelOptions& options);
+// .step .stp .iges .igs: read through OpenCASCADE (when this build has it: LAMINA_HAVE_STEP).
+bool is_cad_path(const std::string& path);
 std::expected<LoadedModel, Error> load_model(const ModelOptions& options);
 
 // A size that suggests the wrong --units (issue 17, item 8): a part under 10 mm at its largest

@@ -133,7 +133,8 @@ struct FacetStep {
   double area_min = 0.0;
 };
 
-FacetStep collect_facets(const WeldResult& w, std::size_t nf_read, const MeshParams& params, Mesh& m) {
+FacetStep collect_facets(const WeldResult& w, std::size_t nf_read, const MeshParams& params, Mesh& m,
+                         std::vector<std::int32_t>* source_triangle) {
   FacetStep r;
   r.area_min = w.tolerance * w.tolerance * params.degenerate_area_factor;
   const double cross2_min = 4.0 * r.area_min * r.area_min;  // |(b − a) × (c − a)|² = (2·area)²
@@ -167,6 +168,7 @@ FacetStep collect_facets(const WeldResult& w, std::size_t nf_read, const MeshPar
       v = slot;
     }
     m.faces.push_back(t);
+    if (source_triangle) source_triangle->push_back(static_cast<std::int32_t>(f));
   }
   return r;
 }
@@ -316,13 +318,23 @@ std::expected<Mesh, Error> build_mesh(const TriangleSoup& soup, const MeshParams
     return std::unexpected(Error{ErrorCode::unsupported,
                                  fmt::format("build_mesh: {} facets is more than this build supports", nf_read)});
 
+  if (soup.brep) {
+    const BrepData& b = *soup.brep;
+    const bool faces_ok = std::all_of(b.triangle_face.begin(), b.triangle_face.end(), [&](std::int32_t i) {
+      return i >= 0 && static_cast<std::size_t>(i) < b.faces.size();
+    });
+    if (b.triangle_face.size() != nf_read || b.corner_normals.size() != 3 * nf_read || !faces_ok)
+      return std::unexpected(Error{ErrorCode::invalid_argument,
+                                   fmt::format("build_mesh: the B-rep data does not match the {} triangles", nf_read)});
+  }
   LAMINA_TIMER();
   // Steps 1–2: build frame, non-finite facets, weld.
   WeldResult w = weld_soup(soup, params);
   LAMINA_TICK("weld");
   Mesh m;
   BuildFacts f;
-  f.facets = collect_facets(w, nf_read, params, m);
+  BrepCarry brep;
+  f.facets = collect_facets(w, nf_read, params, m, soup.brep ? &brep.source_triangle : nullptr);
   f.nf_read = nf_read;
   f.nan_facets = w.nan_facets, f.first_nan = w.first_nan_facet;
   f.merged = w.tolerance_merged;
@@ -340,6 +352,7 @@ std::expected<Mesh, Error> build_mesh(const TriangleSoup& soup, const MeshParams
   f.first_merged.z() -= zmin;
 
   // Steps 4–8.
+  if (soup.brep) brep.faces_as_read = m.faces;
   Adjacency adj = build_edges(m.vertices.size(), m.faces, m.edges, m.edge_faces, m.face_edges);
   LAMINA_TICK("edges");
   compute_normals(m);
@@ -347,8 +360,13 @@ std::expected<Mesh, Error> build_mesh(const TriangleSoup& soup, const MeshParams
   const OrientResult orient = orient_shells(m, adj, params.sharp_angle_rad);
   adj.across = {};
   LAMINA_TICK("orient");
-  const int surfaces = orient.surfaces;
-  renumber_surfaces(m, surfaces);
+  int surfaces = orient.surfaces;
+  if (soup.brep) {
+    apply_brep(m, *soup.brep, brep, build_frame_rotation(params), params.scale_to_mm, zmin);
+    surfaces = static_cast<int>(soup.brep->faces.size());
+  } else {
+    renumber_surfaces(m, surfaces);
+  }
   LAMINA_TICK("surfaces");
 
   // Steps 9–10: summary and defects, one readable line each.

@@ -147,6 +147,18 @@ struct OrientResult {
 // turns facets (and their normals) over in place.
 OrientResult orient_shells(Mesh& m, const Adjacency& adj, double sharp_angle_rad);
 
+// mesh_brep.cpp -------------------------------------------------------------------------------
+
+// What build_mesh keeps of a B-rep soup's facets while it welds and orients them: each kept
+// facet's triangle in the soup and its vertices as first collected.
+struct BrepCarry {
+  std::vector<std::int32_t> source_triangle;
+  std::vector<Tri> faces_as_read;
+};
+// Surfaces = the B-rep's faces; corner normals and face geometry into the build frame.
+void apply_brep(Mesh& m, const BrepData& brep, const BrepCarry& carry, const Eigen::Matrix3d& rotation, double scale,
+                double z_shift);
+
 // Facets grouped by shell: order[begin[s] .. begin[s + 1]) are the facets of shell s.
 struct ShellFaces {
   std::vector<std::int32_t> order;

@@ -30,7 +30,8 @@ struct MeshParams {
   double weld_tolerance_rel = 1e-7;
   // Facets whose area is below (weld tolerance)^2 · this factor are degenerate.
   double degenerate_area_factor = 1.0;
-  // Edges whose dihedral angle (between facet normals) is above this bound surfaces.
+  // Edges whose dihedral angle (between facet normals) is above this bound surfaces. A B-rep
+  // file's triangles carry their CAD faces instead: those are the surfaces, whatever the angle.
   double sharp_angle_rad = 30.0 * 3.14159265358979323846 / 180.0;
 };
 
@@ -83,12 +84,16 @@ struct Mesh {
   std::vector<Eigen::Vector3d> vertices;               // mm, build frame, lowest point at z = 0
   std::vector<std::array<std::int32_t, 3>> faces;      // wound outward (CCW seen from outside)
   std::vector<Eigen::Vector3d> normals;                // unit facet normals, from the winding
-  std::vector<std::int32_t> surface_id;                // per facet: region bounded by sharp edges
+  std::vector<std::int32_t> surface_id;                // per facet: region bounded by sharp edges (a B-rep: its face)
   std::vector<std::int32_t> shell_id;                  // per facet: component joined by manifold edges
   std::vector<Edge> edges;
   std::vector<std::int32_t> edge_faces;                // CSR payload of Edge::face_begin/count
   std::vector<std::array<std::int32_t, 3>> face_edges; // edge of (f[0],f[1]), (f[1],f[2]), (f[2],f[0])
   std::vector<ShellInfo> shell_info;                   // indexed by shell_id
+  // From a B-rep file only (empty for meshes): the surfaces, indexed by surface_id, in the build
+  // frame; and per facet its corners' exact normals, in the order of faces[f].
+  std::vector<BrepFace> brep_faces;
+  std::vector<std::array<Eigen::Vector3f, 3>> corner_normals;
   MeshSummary summary;
   std::vector<Defect> defects;
 
