@@ -1,0 +1,99 @@
+#include "occt_shapes.hpp"
+
+#include <BRepBuilderAPI_MakeFace.hxx>
+#include <BRepAlgoAPI_Cut.hxx>
+#include <BRepFilletAPI_MakeFillet.hxx>
+#include <BRepPrimAPI_MakeBox.hxx>
+#include <BRepPrimAPI_MakeCylinder.hxx>
+#include <BRepPrimAPI_MakePrism.hxx>
+#include <BRepPrimAPI_MakeSphere.hxx>
+#include <BRepPrimAPI_MakeTorus.hxx>
+#include <BRepOffsetAPI_ThruSections.hxx>
+#include <BRepBuilderAPI_MakeEdge.hxx>
+#include <BRepBuilderAPI_MakeWire.hxx>
+#include <GC_MakeArcOfCircle.hxx>
+#include <IGESControl_Writer.hxx>
+#include <STEPCAFControl_Writer.hxx>
+#include <STEPControl_Writer.hxx>
+#include <TDataStd_Name.hxx>
+#include <TDocStd_Document.hxx>
+#include <TopExp_Explorer.hxx>
+#include <TopoDS.hxx>
+#include <XCAFApp_Application.hxx>
+#include <XCAFDoc_DocumentTool.hxx>
+#include <XCAFDoc_ShapeTool.hxx>
+#include <gp_Pln.hxx>
+
+#include <stdexcept>
+
+namespace lamina::step_testing {
+
+TopoDS_Shape filleted_box(double x, double y, double z, double fillet) {
+  const TopoDS_Shape box = BRepPrimAPI_MakeBox(x, y, z).Shape();
+  BRepFilletAPI_MakeFillet round(box);
+  for (TopExp_Explorer e(box, TopAbs_EDGE); e.More(); e.Next()) round.Add(fillet, TopoDS::Edge(e.Current()));
+  return round.Shape();
+}
+
+TopoDS_Shape tube(double outer_r, double inner_r, double height) {
+  const TopoDS_Shape outer = BRepPrimAPI_MakeCylinder(outer_r, height).Shape();
+  const TopoDS_Shape inner = BRepPrimAPI_MakeCylinder(inner_r, height).Shape();
+  return BRepAlgoAPI_Cut(outer, inner).Shape();
+}
+
+TopoDS_Shape box(double x, double y, double z) { return BRepPrimAPI_MakeBox(x, y, z).Shape(); }
+
+TopoDS_Shape sphere(double r) { return BRepPrimAPI_MakeSphere(r).Shape(); }
+
+TopoDS_Shape torus(double major_r, double minor_r) { return BRepPrimAPI_MakeTorus(major_r, minor_r).Shape(); }
+
+// A loft between two arcs of different sagitta (a B-spline face), extruded down 10 mm.
+TopoDS_Shape bspline_solid() {
+  auto wire_of = [](double z, double sag) {
+    const Handle(Geom_TrimmedCurve) arc = GC_MakeArcOfCircle(gp_Pnt(0, 0, z), gp_Pnt(10, sag, z), gp_Pnt(20, 0, z)).Value();
+    const TopoDS_Edge arc_edge = BRepBuilderAPI_MakeEdge(arc);
+    const TopoDS_Edge chord = BRepBuilderAPI_MakeEdge(gp_Pnt(20, 0, z), gp_Pnt(0, 0, z));
+    return BRepBuilderAPI_MakeWire(arc_edge, chord).Wire();
+  };
+  BRepOffsetAPI_ThruSections loft(Standard_True, Standard_False);
+  loft.AddWire(wire_of(0, 4));
+  loft.AddWire(wire_of(15, 8));
+  loft.Build();
+  return loft.Shape();
+}
+
+TopoDS_Shape lone_face() { return BRepBuilderAPI_MakeFace(gp_Pln(gp::Origin(), gp::DZ()), 0, 10, 0, 10).Shape(); }
+
+void write_cad(const TopoDS_Shape& shape, const std::filesystem::path& path) {
+  if (path.extension() == ".igs" || path.extension() == ".iges") {
+    IGESControl_Writer writer("MM", 1);
+    writer.AddShape(shape);
+    writer.ComputeModel();
+    if (!writer.Write(path.c_str())) throw std::runtime_error("IGES write failed: " + path.string());
+    return;
+  }
+  STEPControl_Writer writer;
+  if (writer.Transfer(shape, STEPControl_AsIs) != IFSelect_RetDone || writer.Write(path.c_str()) != IFSelect_RetDone)
+    throw std::runtime_error("STEP write failed: " + path.string());
+}
+
+void write_assembly(const TopoDS_Shape& part, double dx, const std::filesystem::path& path) {
+  Handle(TDocStd_Document) doc;
+  XCAFApp_Application::GetApplication()->NewDocument("MDTV-XCAF", doc);
+  const Handle(XCAFDoc_ShapeTool) tool = XCAFDoc_DocumentTool::ShapeTool(doc->Main());
+  const TDF_Label assembly = tool->NewShape();
+  TDataStd_Name::Set(assembly, "bracket");
+  const TDF_Label part_label = tool->AddShape(part, Standard_False);
+  TDataStd_Name::Set(part_label, "bolt");
+  gp_Trsf moved;
+  moved.SetTranslation(gp_Vec(dx, 0, 0));
+  TDataStd_Name::Set(tool->AddComponent(assembly, part_label, TopLoc_Location()), "bolt 1");
+  TDataStd_Name::Set(tool->AddComponent(assembly, part_label, TopLoc_Location(moved)), "bolt 2");
+  tool->UpdateAssemblies();
+  STEPCAFControl_Writer writer;
+  if (!writer.Transfer(doc, STEPControl_AsIs) || writer.Write(path.c_str()) != IFSelect_RetDone)
+    throw std::runtime_error("STEP assembly write failed: " + path.string());
+  XCAFApp_Application::GetApplication()->Close(doc);
+}
+
+}  // namespace lamina::step_testing
