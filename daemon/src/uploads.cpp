@@ -20,7 +20,8 @@ bool model_extension(const std::string& name) {
   if (dot == std::string::npos) return false;
   std::string ext = name.substr(dot + 1);
   for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return ext == "stl" || ext == "obj" || ext == "3mf";
+  // STEP and IGES too: the planner child says so if it was built without OpenCASCADE.
+  return ext == "stl" || ext == "obj" || ext == "3mf" || ext == "step" || ext == "stp" || ext == "iges" || ext == "igs";
 }
 
 // 128 bits from the kernel's generator, as hex: the upload's capability.
@@ -84,7 +85,7 @@ std::expected<std::string, JobError> Uploads::begin(const std::string& file_name
   if (file_name.empty() || file_name.size() > 200 || file_name.find('/') != std::string::npos || file_name[0] == '.' ||
       control_char)  // a NUL would cut the name on disk short of what the client was told
     return std::unexpected(invalid("params.name: a plain file name (no folders, no control characters), e.g. part.stl"));
-  if (!model_extension(file_name)) return std::unexpected(invalid("params.name: an .stl, .obj or .3mf file"));
+  if (!model_extension(file_name)) return std::unexpected(invalid("params.name: an .stl, .obj, .3mf, .step, .stp, .iges or .igs file"));
   if (size_bytes == 0 || size_bytes > limits_.max_file_bytes)
     return std::unexpected(invalid(fmt::format("params.size: 1 … {} bytes", limits_.max_file_bytes)));
   std::lock_guard lock(mutex_);

@@ -302,6 +302,30 @@ TEST(LaminadProtocol, UploadedModelIsPlanned) {
   EXPECT_EQ(wait_state(c, job["id"], "waiting_sheet", 120)["state"], "waiting_sheet");
 }
 
+// A customer's STEP file, uploaded: planned by a planner built with OpenCASCADE; a planner built
+// without it (the sanitizer build) fails the job with the reason, and the daemon goes on.
+TEST(LaminadProtocol, AnUploadedStepFileIsPlannedOrSaysWhyNot) {
+  const std::string step = std::string(LAMINA_SHARED_MODELS) + "/step_cube_cylinder.step";
+  if (!std::filesystem::exists(step)) GTEST_SKIP() << step << " is not here";
+  Cell cell;
+  Laminad daemon(cell.config(), cell.dir.file(""));
+  const ClientRun run = run_client(cell.socket(), fmt::format("submit '{}' --upload --set stock=10 --json", step));
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const Json job = Json::parse(run.output);
+  RpcClient c = connect(cell.socket());
+  const Json done = wait_job(c, job["id"], [](const Json& j) {
+    return j["state"] == "waiting_sheet" || j["state"] == "failed";
+  }, 120);
+  if (LAMINA_CLI_READS_STEP) {
+    ASSERT_EQ(done["state"], "waiting_sheet") << done.dump(2);
+    EXPECT_EQ(done["sheets"].size(), 1u);
+  } else {
+    ASSERT_EQ(done["state"], "failed") << done.dump(2);
+    EXPECT_NE(done["error"].get<std::string>().find("without STEP support"), std::string::npos) << done["error"];
+  }
+  EXPECT_TRUE(daemon.running());
+}
+
 // systemd may stop a unit the moment it started. Once the socket exists the daemon handles
 // SIGTERM itself (a clean exit 0), never the default action that kills it mid-start.
 TEST(LaminadProtocol, ASigtermRightAfterTheSocketAppearsIsACleanStop) {

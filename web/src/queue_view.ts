@@ -29,7 +29,7 @@ function settingsForm(): { form: HTMLFormElement; read: () => Record<string, unk
     "form",
     { class: "submit", id: "submit-form" },
     h("h2", {}, "Submit a part"),
-    h("label", {}, "Model (STL, OBJ, 3MF) ", h("input", { name: "model", type: "file", accept: ".stl,.obj,.3mf", required: true })),
+    h("label", {}, "Model (STL, OBJ, 3MF, STEP, IGES) ", h("input", { name: "model", type: "file", accept: ".stl,.obj,.3mf,.step,.stp,.iges,.igs", required: true })),
     field("stock", "Stock thicknesses (mm)", { placeholder: "1,2.5,5" }),
     field("stock_file", "or the rack's file on the cell PC", { placeholder: "/srv/lamina/rack.toml" }),
     field("material", "Material", { placeholder: "as the rack says" }),
