@@ -2,6 +2,7 @@
 // corresponding points by intersecting a line with "a short list of line segments"; the grid is
 // that short list.
 #include "lamina/core/section_lines.hpp"
+#include "lamina/core/surface_normal.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -37,7 +38,9 @@ SectionLines::SectionLines(const Mesh& mesh, const Slice& slice) : z_mm_(slice.z
       s.b = l.points[(i + 1) % m];
       s.facet = l.facets[i];
       if (s.facet >= 0) {
-        s.normal = mesh.normals[static_cast<std::size_t>(s.facet)];
+        // A B-rep's surface normal half-way along the crossing (the facet's own for a mesh).
+        const Eigen::Vector2d mid = 0.5 * (s.a + s.b);
+        s.normal = surface_normal_at(mesh, s.facet, Eigen::Vector3d(mid.x(), mid.y(), slice.z_mm));
         s.surface_id = mesh.surface_id[static_cast<std::size_t>(s.facet)];
       } else {
         const Eigen::Vector2d d = (s.b - s.a).normalized();

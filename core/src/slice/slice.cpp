@@ -5,6 +5,7 @@
 // it has a vertex strictly below and one on or above, horizontal facets never cross, and the
 // points on an edge ending at an on-plane vertex are that vertex, bit for bit.
 #include "lamina/core/slice.hpp"
+#include "lamina/core/surface_normal.hpp"
 
 #include "slice/slice_internal.hpp"
 
@@ -278,7 +279,8 @@ ContourVector Slice::vector(const Mesh& mesh, std::size_t loop, std::size_t inde
   v.z_mm = z_mm;
   v.facet = l.facets[index];
   if (v.facet >= 0) {
-    v.normal = mesh.normals[static_cast<std::size_t>(v.facet)];
+    const Eigen::Vector2d mid = 0.5 * (v.start_mm + v.end_mm);
+    v.normal = surface_normal_at(mesh, v.facet, Eigen::Vector3d(mid.x(), mid.y(), z_mm));
     v.surface_id = mesh.surface_id[static_cast<std::size_t>(v.facet)];
   } else {
     // A gap vector: the horizontal normal on its right, where the outside is (t × z).
