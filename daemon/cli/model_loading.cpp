@@ -31,12 +31,6 @@ MeshParams mesh_params_from(const ModelOptions& o) {
   return p;
 }
 
-bool is_cad_path(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return ext == ".step" || ext == ".stp" || ext == ".iges" || ext == ".igs";
-}
-
 namespace {
 
 std::expected<TriangleSoup, Error> read_cad(const ModelOptions& options) {

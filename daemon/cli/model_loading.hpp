@@ -37,8 +37,6 @@ struct LoadedModel {
 };
 
 MeshParams mesh_params_from(const ModelOptions& options);
-// .step .stp .iges .igs: read through OpenCASCADE (when this build has it: LAMINA_HAVE_STEP).
-bool is_cad_path(const std::string& path);
 std::expected<LoadedModel, Error> load_model(const ModelOptions& options);
 
 // A size that suggests the wrong --units (issue 17, item 8): a part under 10 mm at its largest

@@ -119,12 +119,6 @@ std::expected<TriangleSoup, Error> stream_binary_stl(InputFile& file, std::byte*
   return std::move(decoder).finish(name, file.size(), quote);
 }
 
-std::string lower_extension(const std::filesystem::path& path) {
-  std::string ext = path.extension().string();
-  for (char& c : ext) c = io_detail::ascii_lower(c);
-  return ext;
-}
-
 // OBJ statements a file typically starts with (after comments and blank lines).
 bool looks_like_obj(std::string_view text) {
   std::size_t pos = 0;
@@ -165,6 +159,17 @@ std::expected<TriangleSoup, Error> not_stl(const Bytes& all, Error stl_error, co
 }
 
 }  // namespace
+
+std::string lower_extension(const std::filesystem::path& path) {
+  std::string ext = path.extension().string();
+  for (char& c : ext) c = io_detail::ascii_lower(c);
+  return ext;
+}
+
+bool is_cad_path(const std::filesystem::path& path) {
+  const std::string ext = lower_extension(path);
+  return ext == ".step" || ext == ".stp" || ext == ".iges" || ext == ".igs";
+}
 
 std::expected<TriangleSoup, Error> read_mesh_file(const std::filesystem::path& path, const MeshReadOptions& options) {
   const std::string name = path.string();

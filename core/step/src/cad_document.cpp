@@ -2,6 +2,8 @@
 // it, then read with XCAF (names, assembly structure) and walked to its placed solids.
 #include "cad_document.hpp"
 
+#include "lamina/core/mesh_io.hpp"
+
 #include <IFSelect_ReturnStatus.hxx>
 #include <IGESCAFControl_Reader.hxx>
 #include <IGESData_GlobalSection.hxx>
@@ -33,12 +35,6 @@ namespace lamina::step_detail {
 namespace {
 
 Error error(ErrorCode code, std::string message) { return Error{code, std::move(message)}; }
-
-std::string lower_extension(const std::filesystem::path& path) {
-  std::string ext = path.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return ext;
-}
 
 // The first and last bytes: a STEP file begins "ISO-10303-21;" and ends "END-ISO-10303-21;"; an
 // IGES file's last record is its terminate section (a 'T' in column 73).

@@ -15,12 +15,6 @@
 
 namespace lamina {
 
-bool is_cad_file(const std::filesystem::path& path) {
-  std::string ext = path.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return ext == ".step" || ext == ".stp" || ext == ".iges" || ext == ".igs";
-}
-
 namespace {
 
 // At most this many of OCCT's distinct messages become notes (a broken file can say thousands).

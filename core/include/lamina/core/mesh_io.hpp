@@ -8,6 +8,7 @@
 #include <expected>
 #include <filesystem>
 #include <span>
+#include <string>
 #include <string_view>
 
 namespace lamina {
@@ -53,6 +54,11 @@ std::expected<TriangleSoup, Error> parse_obj(std::string_view text, std::string_
 // at build time; without it the result is Error unsupported.
 std::expected<TriangleSoup, Error> parse_3mf(std::span<const std::byte> bytes, std::string_view name,
                                              const MeshReadOptions& options = {});
+
+// The file's extension in lower case, with its dot (".step"); "" when it has none.
+std::string lower_extension(const std::filesystem::path& path);
+// .step .stp .iges .igs: a B-rep file, read by lamina_step (lamina/step/cad_reader.hpp), not here.
+bool is_cad_path(const std::filesystem::path& path);
 
 // Read a mesh file; the format comes from the content (STL) or the extension (.obj, .3mf).
 std::expected<TriangleSoup, Error> read_mesh_file(const std::filesystem::path& path,

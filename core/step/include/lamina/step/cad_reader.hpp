@@ -29,9 +29,6 @@ struct CadReadOptions {
   bool quote_file_text = true;
 };
 
-// .step .stp .iges .igs, in any case.
-bool is_cad_file(const std::filesystem::path& path);
-
 // Read a STEP or IGES file (by its extension). Corners in mm whatever the file's unit (which the
 // result's brep->length_unit names). Errors: io_error (cannot open), unknown_format or
 // parse_error (not a STEP / IGES file, or one the reader rejects), truncated_file, empty_mesh
