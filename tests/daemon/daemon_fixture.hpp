@@ -184,7 +184,11 @@ struct ClientRun {
   int exit_code = -1;
   std::string output;
 };
+
+// The client as the operator runs it, once the daemon listens (a sanitized daemon starts slowly:
+// without the wait the client can race its start).
 inline ClientRun run_client(const std::string& socket, const std::string& args) {
+  (void)connect(socket);
   const std::string command = fmt::format("timeout -k 5 120 '{}' {} --socket '{}' 2>&1 < /dev/null", LAMINA_CLI, args, socket);
   ClientRun r;
   FILE* pipe = ::popen(command.c_str(), "r");
