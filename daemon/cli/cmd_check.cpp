@@ -31,6 +31,9 @@ void add_check_command(CLI::App& app, int& exit_code) {
                s.bbox_max_mm.z() - s.bbox_min_mm.z(), options->axis, options->units);
     fmt::print("  volume     {:.6g} mm3{}\n", s.volume_mm3, s.watertight ? "" : " (not closed: approximate)");
     fmt::print("  shells {}, surfaces {}, watertight {}\n", s.shells, s.surfaces, s.watertight ? "yes" : "no");
+    const auto cad = cad_report(*model, *options);
+    if (cad)
+      for (const std::string& line : cad_lines(*cad)) fmt::print("  {}\n", line);
     for (const ReadNote& n : model->notes) fmt::print("  [note]     {}: {}\n", n.code, n.message);
     for (const Defect& d : model->mesh.defects) fmt::print("  [{}] {}: {}\n", severity_name(d.severity), d.code, d.message);
     const auto overlap = overlapping_shells(model->mesh);
@@ -45,7 +48,9 @@ void add_check_command(CLI::App& app, int& exit_code) {
         exit_code = 1;
         return;
       }
-      fmt::print(f.get(), "{}\n", mesh_json(*model).dump(2));
+      nlohmann::json j = mesh_json(*model);
+      if (cad) j["cad"] = nlohmann::json::parse(report_cad_json(*cad));
+      fmt::print(f.get(), "{}\n", j.dump(2));
     }
     exit_code = usable ? 0 : 1;
   });

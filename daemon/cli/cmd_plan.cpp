@@ -8,6 +8,7 @@
 #include "plan_progress.hpp"
 #include "plan_report.hpp"
 
+#include "lamina/core/elapsed.hpp"
 #include "lamina/core/as_cut.hpp"
 #include "lamina/core/plan_job.hpp"
 #include "lamina/core/stack_mesh.hpp"
@@ -31,7 +32,6 @@ namespace {
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 int report_error(const Error& e, int exit_code = 1) {
   fmt::print(stderr, "error [{}]: {}\n", error_code_name(e.code), e.message);
@@ -134,7 +134,9 @@ int run_plan(const PlanOptions& o, const CamOptions& cam_options) {
   }
   // A typo in --out must not cost a full plan; nothing is created before the plan is whole.
   if (auto ok = check_out_dir(o.out_dir); !ok) return report_error(ok.error());
-  PlanProgress progress(o.progress_fd, request.cam ? 7 : 5);
+  // A B-rep file is read twice: once to plan, once finer for the deviation's reference.
+  const bool reads_reference = is_cad_path(o.model.path) && o.deviation_chord_mm.value_or(1) > 0;
+  PlanProgress progress(o.progress_fd, (request.cam ? 7 : 5) + (reads_reference ? 1 : 0));
 
   progress.phase("reading the model");
   ModelOptions model_options = o.model;
@@ -146,7 +148,15 @@ int run_plan(const PlanOptions& o, const CamOptions& cam_options) {
     return report_error({ErrorCode::invalid_argument,
                          fmt::format("{} is not usable as a solid (see lamina check {})", o.model.path, o.model.path)});
   request.model = {o.model.path, model->format, o.model.units, o.model.axis, o.model.direction, model->read_s,
-                   model->topology_s};
+                   model->topology_s, cad_report(*model, model_options)};
+  if (request.model.cad && reads_reference) {
+    const double chord = o.deviation_chord_mm.value_or(*model_options.chord_tolerance_mm / 10);
+    progress.phase("reading the reference surface");
+    auto reference = load_reference(model_options, mesh, chord);
+    if (!reference) return report_error(reference.error());
+    request.deviation_reference = std::move(*reference);
+    request.model.cad->deviation_chord_tolerance_mm = chord;
+  }
   request.warnings = model_warnings(request.settings, mesh, o, request.cam);
 
   auto r = plan_job(mesh, request, [&](const PlanStep& step) {

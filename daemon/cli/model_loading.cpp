@@ -1,5 +1,6 @@
 #include "model_loading.hpp"
 
+#include "lamina/core/elapsed.hpp"
 #include "lamina/core/mesh_io.hpp"
 #if LAMINA_HAVE_STEP
 #include "lamina/step/cad_reader.hpp"
@@ -12,15 +13,10 @@
 #include <cctype>
 #include <chrono>
 #include <filesystem>
+#include <map>
 #include <numbers>
 
 namespace lamina::cli {
-namespace {
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
-}  // namespace
-
 MeshParams mesh_params_from(const ModelOptions& o) {
   MeshParams p;
   p.scale_to_mm = o.units == "in" ? 25.4 : 1.0;
@@ -63,7 +59,8 @@ std::expected<LoadedModel, Error> load_model(const ModelOptions& options) {
   out.format = soup->format;
   out.notes = soup->notes;
   if (soup->brep) {
-    out.brep = BrepData{{}, {}, soup->brep->faces, soup->brep->solids, soup->brep->length_unit};
+    out.brep = BrepData{{}, {}, soup->brep->faces, soup->brep->solids, soup->brep->length_unit,
+                        soup->brep->chord_tolerance_mm};
   }
   t0 = std::chrono::steady_clock::now();
   auto mesh = build_mesh(*soup, mesh_params_from(options));
@@ -72,6 +69,44 @@ std::expected<LoadedModel, Error> load_model(const ModelOptions& options) {
   out.mesh = std::move(*mesh);
   if (options.surface_normals == "facet") out.mesh.corner_normals.clear();
   return out;
+}
+
+std::optional<ReportCad> cad_report(const LoadedModel& model, const ModelOptions& options) {
+  if (!model.brep) return std::nullopt;
+  const BrepData& b = *model.brep;
+  ReportCad cad{.length_unit = b.length_unit, .chord_tolerance_mm = b.chord_tolerance_mm,
+                .surface_normals = options.surface_normals};
+  for (const BrepSolid& s : b.solids)
+    cad.solids.push_back({s.name, static_cast<std::int64_t>(s.faces), static_cast<std::int64_t>(s.triangles)});
+  std::map<SurfaceKind, std::int64_t> faces_of_kind;
+  for (const BrepFace& f : b.faces) ++faces_of_kind[f.kind];
+  for (const auto& [kind, faces] : faces_of_kind) cad.surface_kinds.emplace_back(surface_kind_name(kind), faces);
+  return cad;
+}
+
+std::expected<std::shared_ptr<const Mesh>, Error> load_reference(const ModelOptions& options, const Mesh& planned,
+                                                                  double chord_mm) {
+  ModelOptions fine = options;
+  fine.chord_tolerance_mm = chord_mm;
+  auto model = load_model(fine);
+  if (!model) return std::unexpected(model.error());
+  return std::make_shared<const Mesh>(in_frame_of(std::move(model->mesh), planned));
+}
+
+std::vector<std::string> cad_lines(const ReportCad& cad) {
+  std::int64_t faces = 0;
+  std::string kinds;
+  for (const auto& [kind, n] : cad.surface_kinds) {
+    faces += n;
+    kinds += fmt::format("{}{} {}", kinds.empty() ? "" : ", ", kind, n);
+  }
+  std::vector<std::string> lines{
+      fmt::format("B-rep      {} solid{}, {} faces ({}); unit {}; tessellated to {:g} mm; {} normals", cad.solids.size(),
+                  cad.solids.size() == 1 ? "" : "s", faces, kinds, cad.length_unit.empty() ? "not said (mm)" : cad.length_unit,
+                  cad.chord_tolerance_mm, cad.surface_normals)};
+  for (const ReportCadSolid& s : cad.solids)
+    lines.push_back(fmt::format("  solid    {}: {} faces, {} triangles", s.name.empty() ? "(unnamed)" : s.name, s.faces, s.triangles));
+  return lines;
 }
 
 std::optional<std::string> overlapping_shells(const Mesh& mesh) {

@@ -1,8 +1,10 @@
 #pragma once
 // The CLI's edge: parse unit/axis options once, read the file, build the mesh, time each phase.
 #include "lamina/core/mesh.hpp"
+#include "lamina/core/plan_report.hpp"
 
 #include <expected>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -38,6 +40,15 @@ struct LoadedModel {
 
 MeshParams mesh_params_from(const ModelOptions& options);
 std::expected<LoadedModel, Error> load_model(const ModelOptions& options);
+
+// What a STEP / IGES file told us, as the plan report and `lamina check --json` give it
+// (model.cad); nullopt for a mesh. cad_lines: the same for a person, one line each.
+std::optional<ReportCad> cad_report(const LoadedModel& model, const ModelOptions& options);
+std::vector<std::string> cad_lines(const ReportCad& cad);
+// The same file tessellated again to `chord_mm`, in `planned`'s frame (the planned deviation's
+// reference: the CAD surface to within that chord).
+std::expected<std::shared_ptr<const Mesh>, Error> load_reference(const ModelOptions& options, const Mesh& planned,
+                                                                  double chord_mm);
 
 // A size that suggests the wrong --units (issue 17, item 8): a part under 10 mm at its largest
 // read as mm (an inch file: 25.4 times that), or a part larger than the sheet read as inches

@@ -93,6 +93,10 @@ void add_plan_options(CLI::App& cmd, PlanOptions& o) {
   cmd.add_option("--deviation-step", o.deviation_step_mm, "Spacing of the sections the deviation is integrated over (mm)")
       ->check(in_range(0.0, true, 1e308, "mm"))
       ->capture_default_str();
+  cmd.add_option("--deviation-chord-tolerance", o.deviation_chord_mm,
+                 "STEP / IGES: measure the deviation against the file tessellated to this chord, mm (0: against the "
+                 "planned tessellation; default a tenth of its chord: the CAD surface to within that)")
+      ->check(CLI::Range(0.0, 10.0));
   cmd.add_option("--compare-strategies", o.compare_strategies,
                  "Also measure the deviation of the strategies not chosen, on the same layering (true/false; it "
                  "about doubles the time)")

@@ -36,6 +36,9 @@ struct PlanOptions {
   bool all_rows = false;
   int progress_fd = -1;                   // --progress-fd: phase lines for laminad (plan_progress.hpp)
   std::string as_cut_dir;                 // --as-cut: the sheets as cut (sheet-<n>.ascut.json), measured beside the plan
+  // STEP / IGES: the chord of the tessellation the deviation is measured against (0: the planned
+  // tessellation itself). Unset: a tenth of the planned one's.
+  std::optional<double> deviation_chord_mm;
 };
 
 // Validated, in core units: PlanSettings (lamina/core/plan_job.hpp).

@@ -16,7 +16,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-JobError invalid(std::string message) { return JobError{JobErrorKind::bad_request, std::move(message)}; }
 JobError storage(std::string message) { return JobError{JobErrorKind::storage, std::move(message)}; }
 
 struct Fd {
@@ -93,25 +92,25 @@ std::expected<Fd, JobError> open_checked(const std::string& path, std::string_vi
                                          struct stat& st) {
   Fd handle(::open(path.c_str(), O_PATH | O_CLOEXEC));
   if (handle.fd < 0)
-    return std::unexpected(invalid(fmt::format("{}: {}: {}", param, path,
+    return std::unexpected(bad_request(fmt::format("{}: {}: {}", param, path,
                                                errno == ENOENT ? "no such file" : std::strerror(errno))));
   auto real = opened_path(handle.fd);
-  if (!real) return std::unexpected(invalid(fmt::format("{}: {}: {}", param, path, real.error())));
+  if (!real) return std::unexpected(bad_request(fmt::format("{}: {}: {}", param, path, real.error())));
   if (!inside_canonical_roots(*real, rules.roots))
-    return std::unexpected(invalid(fmt::format("{}: {} leads outside the folders jobs may read ({})", param, path,
+    return std::unexpected(bad_request(fmt::format("{}: {} leads outside the folders jobs may read ({})", param, path,
                                                list_roots(rules.roots))));
   if (::fstat(handle.fd, &st) != 0 || !S_ISREG(st.st_mode))
-    return std::unexpected(invalid(fmt::format("{}: {} is not a regular file", param, path)));
-  if (st.st_size == 0) return std::unexpected(invalid(fmt::format("{}: {} is empty", param, path)));
+    return std::unexpected(bad_request(fmt::format("{}: {} is not a regular file", param, path)));
+  if (st.st_size == 0) return std::unexpected(bad_request(fmt::format("{}: {} is empty", param, path)));
   if (static_cast<std::uint64_t>(st.st_size) > rules.max_bytes)
-    return std::unexpected(invalid(fmt::format("{}: {} is {} bytes, more than the {} allowed", param, path, st.st_size,
+    return std::unexpected(bad_request(fmt::format("{}: {} is {} bytes, more than the {} allowed", param, path, st.st_size,
                                                rules.max_bytes)));
   Fd file(::open(fmt::format("/proc/self/fd/{}", handle.fd).c_str(), O_RDONLY | O_CLOEXEC | O_NOCTTY));
   if (file.fd < 0)
-    return std::unexpected(invalid(fmt::format("{}: cannot read {}: {}", param, path, std::strerror(errno))));
+    return std::unexpected(bad_request(fmt::format("{}: cannot read {}: {}", param, path, std::strerror(errno))));
   struct stat again {};
   if (::fstat(file.fd, &again) != 0 || again.st_ino != st.st_ino || again.st_dev != st.st_dev)
-    return std::unexpected(invalid(fmt::format("{}: {} changed while it was opened", param, path)));
+    return std::unexpected(bad_request(fmt::format("{}: {} changed while it was opened", param, path)));
   return file;
 }
 
@@ -126,11 +125,11 @@ bool inside_roots(const fs::path& path, const std::vector<fs::path>& roots) {
 std::expected<fs::path, JobError> import_client_file(const std::string& path, std::string_view param,
                                                      const ClientFileRules& rules, const fs::path& target_dir) {
   if (path.empty() || path.front() != '/')
-    return std::unexpected(invalid(fmt::format("{}: expected an absolute path on the cell PC", param)));
+    return std::unexpected(bad_request(fmt::format("{}: expected an absolute path on the cell PC", param)));
   if (path.find('\0') != std::string::npos)
-    return std::unexpected(invalid(fmt::format("{}: the path holds a NUL character", param)));
+    return std::unexpected(bad_request(fmt::format("{}: the path holds a NUL character", param)));
   if (!inside_roots(path, rules.roots))
-    return std::unexpected(invalid(fmt::format("{}: {} is outside the folders jobs may read ({}); copy the file there "
+    return std::unexpected(bad_request(fmt::format("{}: {} is outside the folders jobs may read ({}); copy the file there "
                                                "or upload it",
                                                param, path, list_roots(rules.roots))));
   struct stat st {};

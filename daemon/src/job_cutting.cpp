@@ -17,7 +17,7 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-std::shared_ptr<spdlog::logger> log() {
+std::shared_ptr<spdlog::logger> cut_log() {
   static auto logger = [] {
     auto l = spdlog::get("cut");
     return l ? l : spdlog::default_logger()->clone("cut");
@@ -144,10 +144,10 @@ void JobManager::cut_sheet(std::string job_id, int sheet_index, CutStart how, st
   drivers::CutJob& cut = *cut_;  // replaced only by start_cut, after this thread is joined
   drivers::CutReport report;
   if (how == CutStart::fresh) {
-    log()->info("job {}: cutting sheet {} ({} lines)", job_id, sheet_index, program.size());
+    cut_log()->info("job {}: cutting sheet {} ({} lines)", job_id, sheet_index, program.size());
     report = cut.run();
   } else if (how == CutStart::resume_stopped) {
-    log()->info("job {}: resuming sheet {}", job_id, sheet_index);
+    cut_log()->info("job {}: resuming sheet {}", job_id, sheet_index);
     report = cut.resume();
   } else {
     // After a restart: connect, make sure nothing moves, read where the CNC got to.
@@ -157,7 +157,7 @@ void JobManager::cut_sheet(std::string job_id, int sheet_index, CutStart how, st
     // The PLC's button too, and wait until it has acted: the resume below resets the CNC over
     // its line, and a press handed on after that reset would leave the restarted program held.
     if (machine_.cell())
-      if (auto held = machine_.cell()->hold_cnc(); !held) log()->warn("job {}: feed hold through the PLC: {}", job_id, held.error().message);
+      if (auto held = machine_.cell()->hold_cnc(); !held) cut_log()->warn("job {}: feed hold through the PLC: {}", job_id, held.error().message);
     SheetRecord sheet;
     {
       std::lock_guard lock(mutex_);
@@ -170,7 +170,7 @@ void JobManager::cut_sheet(std::string job_id, int sheet_index, CutStart how, st
       std::lock_guard lock(mutex_);
       if (JobRecord* job = find(job_id)) event(*job, "resume", {{"sheet", sheet_index}, {"first_unfinished_line", line + 1}, {"how", note}});
     }
-    log()->info("job {}: resuming interrupted sheet {} near line {} ({})", job_id, sheet_index, line + 1, note);
+    cut_log()->info("job {}: resuming interrupted sheet {} near line {} ({})", job_id, sheet_index, line + 1, note);
     report = cut.resume_from(line);
   }
   finish_cut(job_id, sheet_index, report);
@@ -213,7 +213,7 @@ void JobManager::machine_held(const std::string& job_id, const drivers::LinkErro
   std::lock_guard lock(mutex_);
   JobRecord* job = find(job_id);
   if (!job || job->state != JobState::cutting || !cutting_) return;
-  log()->warn("job {}: held: {}", job_id, why.message);
+  cut_log()->warn("job {}: held: {}", job_id, why.message);
   pause_ = PauseKind::hold;
   (void)set_state(*job, JobState::paused, why.message);
 }

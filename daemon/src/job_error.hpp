@@ -4,6 +4,7 @@
 // JSON-RPC's in api_methods.cpp — so the web console's HTTP statuses can map them too, and the
 // domain never includes the RPC server.
 #include <string>
+#include <utility>
 
 namespace lamina::daemon {
 
@@ -23,5 +24,6 @@ struct JobError {
 };
 
 inline JobError job_error(JobErrorKind kind, std::string message) { return JobError{kind, std::move(message)}; }
+inline JobError bad_request(std::string message) { return job_error(JobErrorKind::bad_request, std::move(message)); }
 
 }  // namespace lamina::daemon

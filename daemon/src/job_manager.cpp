@@ -22,18 +22,13 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::int64_t now_unix_ms() {
-  return std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
-
 std::string new_job_id() {
   static std::mt19937 rng{std::random_device{}()};
   return fmt::format("j-{}-{:04x}", now_unix_ms(), rng() & 0xFFFF);
 }
 
 
-std::shared_ptr<spdlog::logger> log() {
+std::shared_ptr<spdlog::logger> jobs_log() {
   static auto logger = [] {
     auto l = spdlog::get("jobs");
     return l ? l : spdlog::default_logger()->clone("jobs");
@@ -131,7 +126,7 @@ std::expected<void, JobError> JobManager::set_state(JobRecord& job, JobState to,
   }
   job = std::move(next);
   event(job, "state", {{"from", to_string(from)}, {"to", to_string(to)}, {"reason", why}});
-  log()->info("job {}: {} → {}{}", job.id, to_string(from), to_string(to), why.empty() ? "" : " (" + why + ")");
+  jobs_log()->info("job {}: {} → {}{}", job.id, to_string(from), to_string(to), why.empty() ? "" : " (" + why + ")");
   announce(job);
   return {};
 }
@@ -155,7 +150,7 @@ void JobManager::event(const JobRecord& job, const std::string& kind, nlohmann::
 void JobManager::store_failed(const std::string& message) {
   if (store_fault_) return;
   store_fault_ = message;
-  log()->critical("the job store cannot be written: {}. The cut is stopped; free the disk and restart laminad", message);
+  jobs_log()->critical("the job store cannot be written: {}. The cut is stopped; free the disk and restart laminad", message);
   if (cutting_ && cut_) cut_->abort(fmt::format("the job store cannot be written ({})", message));
   if (notify_) notify_("notify_machine_status", {{"store", {{"ok", false}, {"error", message}}}});
 }
@@ -270,7 +265,7 @@ std::expected<JobRecord, JobError> JobManager::submit(SubmitRequest r) {
   event(job, "state", {{"from", nullptr}, {"to", "queued"}, {"reason", "submitted"},
                        {"source", r.move_into_job ? nlohmann::json("upload") : nlohmann::json(r.model_path)},
                        {"by", r.by.user}, {"role", role_name(r.by.role)}});
-  log()->info("job {}: queued ({}, from {})", job.id, job.model_path, r.move_into_job ? "an upload" : r.model_path);
+  jobs_log()->info("job {}: queued ({}, from {})", job.id, job.model_path, r.move_into_job ? "an upload" : r.model_path);
   jobs_[job.id] = job;
   plan_queue_.push_back(job.id);
   plan_wake_.notify_one();

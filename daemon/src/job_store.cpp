@@ -99,11 +99,6 @@ std::string dump(const nlohmann::json& value) {
   return value.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
-std::int64_t now_unix_ms() {
-  using namespace std::chrono;
-  return duration_cast<milliseconds>(system_clock::now().time_since_epoch()).count();
-}
-
 // The store's own settings and schema on a freshly opened connection. Errors name the file.
 std::expected<void, StoreError> prepare_database(Connection& db) {
   auto fail = [&](std::string_view what) {

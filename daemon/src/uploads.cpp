@@ -13,7 +13,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-JobError invalid(std::string message) { return JobError{JobErrorKind::bad_request, std::move(message)}; }
 
 bool model_extension(const std::string& name) {
   const auto dot = name.rfind('.');
@@ -84,10 +83,10 @@ std::expected<std::string, JobError> Uploads::begin(const std::string& file_name
                                         [](char c) { return static_cast<unsigned char>(c) < 0x20 || c == 0x7F; });
   if (file_name.empty() || file_name.size() > 200 || file_name.find('/') != std::string::npos || file_name[0] == '.' ||
       control_char)  // a NUL would cut the name on disk short of what the client was told
-    return std::unexpected(invalid("params.name: a plain file name (no folders, no control characters), e.g. part.stl"));
-  if (!model_extension(file_name)) return std::unexpected(invalid("params.name: an .stl, .obj, .3mf, .step, .stp, .iges or .igs file"));
+    return std::unexpected(bad_request("params.name: a plain file name (no folders, no control characters), e.g. part.stl"));
+  if (!model_extension(file_name)) return std::unexpected(bad_request("params.name: an .stl, .obj, .3mf, .step, .stp, .iges or .igs file"));
   if (size_bytes == 0 || size_bytes > limits_.max_file_bytes)
-    return std::unexpected(invalid(fmt::format("params.size: 1 … {} bytes", limits_.max_file_bytes)));
+    return std::unexpected(bad_request(fmt::format("params.size: 1 … {} bytes", limits_.max_file_bytes)));
   std::lock_guard lock(mutex_);
   expire(now);
   if (open_.size() >= limits_.max_open)
@@ -120,16 +119,16 @@ std::expected<Uploads::Upload*, JobError> Uploads::find(const std::string& id, C
   expire(now);
   auto it = open_.find(id);
   // The same answer for an id that never was, expired or was taken: the id is all a client has.
-  if (it == open_.end()) return std::unexpected(invalid(fmt::format("params.upload: no upload {} (unknown, expired or taken)", id)));
+  if (it == open_.end()) return std::unexpected(bad_request(fmt::format("params.upload: no upload {} (unknown, expired or taken)", id)));
   return &it->second;
 }
 
 std::expected<std::uint64_t, JobError> Uploads::chunk(const std::string& id, std::uint64_t offset, std::string_view base64,
                                                       Clock::time_point now) {
   auto data = decode_base64(base64);
-  if (!data) return std::unexpected(invalid("params.data: not base64"));
+  if (!data) return std::unexpected(bad_request("params.data: not base64"));
   if (data->empty() || data->size() > limits_.max_chunk_bytes)
-    return std::unexpected(invalid(fmt::format("params.data: 1 … {} bytes per chunk", limits_.max_chunk_bytes)));
+    return std::unexpected(bad_request(fmt::format("params.data: 1 … {} bytes per chunk", limits_.max_chunk_bytes)));
   return append(id, offset, *data, now);
 }
 
@@ -140,9 +139,9 @@ std::expected<std::uint64_t, JobError> Uploads::append(const std::string& id, st
   if (!found) return std::unexpected(found.error());
   Upload& u = **found;
   // In order: the next chunk, or the last one again (a client retrying after a lost reply).
-  if (offset > u.received) return std::unexpected(invalid(fmt::format("params.offset: {} leaves a gap (received {})", offset, u.received)));
+  if (offset > u.received) return std::unexpected(bad_request(fmt::format("params.offset: {} leaves a gap (received {})", offset, u.received)));
   if (offset + data.size() > u.size)
-    return std::unexpected(invalid(fmt::format("params.offset: the chunk ends past the announced size {}", u.size)));
+    return std::unexpected(bad_request(fmt::format("params.offset: the chunk ends past the announced size {}", u.size)));
   std::fstream f(u.path, std::ios::binary | std::ios::in | std::ios::out);
   f.seekp(static_cast<std::streamoff>(offset));
   f.write(data.data(), static_cast<std::streamsize>(data.size()));
@@ -157,7 +156,7 @@ std::expected<fs::path, JobError> Uploads::take(const std::string& id, Clock::ti
   auto found = find(id, now);
   if (!found) return std::unexpected(found.error());
   if ((*found)->received != (*found)->size)
-    return std::unexpected(invalid(fmt::format("params.upload: {} of {} bytes received", (*found)->received, (*found)->size)));
+    return std::unexpected(bad_request(fmt::format("params.upload: {} of {} bytes received", (*found)->received, (*found)->size)));
   fs::path p = (*found)->path;
   open_.erase(id);
   return p;
@@ -166,7 +165,7 @@ std::expected<fs::path, JobError> Uploads::take(const std::string& id, Clock::ti
 std::expected<void, JobError> Uploads::cancel(const std::string& id) {
   std::lock_guard lock(mutex_);
   auto it = open_.find(id);
-  if (it == open_.end()) return std::unexpected(invalid(fmt::format("params.upload: no upload {} (unknown, expired or taken)", id)));
+  if (it == open_.end()) return std::unexpected(bad_request(fmt::format("params.upload: no upload {} (unknown, expired or taken)", id)));
   std::error_code ec;
   fs::remove(it->second.path, ec);
   open_.erase(it);

@@ -61,9 +61,10 @@ void add_cell_options(CLI::App& app, lamina::sim::SimOptions& o, CliExtras& x) {
   app.add_option("--log", o.log_path, "execution log, JSON lines");
   app.add_option("--baud", o.baud, "emulated line speed, 8N1 (default 115200)");
   app.add_option("--time-scale", o.time_scale, "run the machine K times faster than real time");
-  app.add_flag("--pace-to-host", o.pace_to_host,
+  app.add_flag("--pace-to-host,!--no-pace-to-host", o.pace_to_host,
                "drop to real time while the controller holds under 1 s of motion and the host owes it more "
-               "(a loaded test machine's pauses then cannot starve a host that keeps a real machine fed)");
+               "(a loaded test machine's pauses then cannot starve a host that keeps a real machine fed); "
+               "--no-pace-to-host: the time scale throughout (the default)");
   app.add_option("--on-open", x.on_open,
                  "when a client opens the port: quiet (default: native-USB grblHAL says nothing), banner, or reset (a classic Grbl's DTR reset)")
       ->check(CLI::IsMember({"banner", "reset", "quiet"}));

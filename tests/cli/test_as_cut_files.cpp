@@ -13,6 +13,7 @@
 namespace {
 
 using namespace lamina_cli_test;
+using lamina_cli_test::lamina;  // the function, not namespace lamina (the files share a unity build)
 using lamina::cli::parse_cut_sheet;
 using lamina::cli::program_fingerprint;
 

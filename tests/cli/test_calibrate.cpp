@@ -15,6 +15,7 @@
 namespace {
 
 using namespace lamina_cli_test;
+using lamina_cli_test::lamina;  // the function, not namespace lamina (the files share a unity build)
 using lamina::KerfModel;
 
 const KerfModel kTruth{.top_width_mm = 0.92,

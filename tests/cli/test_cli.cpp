@@ -12,6 +12,7 @@
 namespace {
 
 using namespace lamina_cli_test;
+using lamina_cli_test::lamina;  // the function, not namespace lamina (the files share a unity build)
 
 TEST(Cli, CheckOnTheExampleIsUsableAndWatertight) {
   const CliRun r = lamina("check " + quoted(kKnob));

@@ -17,6 +17,7 @@
 namespace {
 
 using namespace lamina_cli_test;
+using lamina_cli_test::lamina;  // the function, not namespace lamina (the files share a unity build)
 using nlohmann::json;
 
 const fs::path kStockToml = fs::path(LAMINA_EXAMPLES_DIR).parent_path() / "config" / "stock.toml";
@@ -335,7 +336,7 @@ TEST(CliPlan, ASizeThatSuggestsTheWrongUnitsIsSaid) {
   const fs::path tiny = temp_file("tiny-inch-part.stl"), plate = temp_file("mm-plate.stl");
   write_box_stl(tiny, 2.7, 2.0, 2.5);
   write_box_stl(plate, 120, 60, 1);
-  CliRun r = lamina("plan " + quoted(tiny) + " --stock 0.5,1 --sub-slice 0.25 --no-programs --out " + quoted(out.path));
+  CliRun r = lamina_cli_test::lamina("plan " + quoted(tiny) + " --stock 0.5,1 --sub-slice 0.25 --no-programs --out " + quoted(out.path));
   EXPECT_EQ(r.exit_code, 0) << r.out;
   EXPECT_TRUE(has_text(r, "2.70 mm at its largest): if the file is in inches, give --units in (it would be 68.6 mm)"))
       << r.out;
@@ -343,12 +344,12 @@ TEST(CliPlan, ASizeThatSuggestsTheWrongUnitsIsSaid) {
   // deviation alone took 2 s, 20 s under the sanitizers).
   const fs::path bar = temp_file("mm-bar.stl");
   write_box_stl(bar, 100, 1, 1);
-  r = lamina("plan " + quoted(bar) + " --units in --stock 10 --no-programs --out " + quoted(out.path));
+  r = lamina_cli_test::lamina("plan " + quoted(bar) + " --units in --stock 10 --no-programs --out " + quoted(out.path));
   EXPECT_EQ(r.exit_code, 0) << r.out;
   EXPECT_TRUE(has_text(r, "larger than the 2500 mm sheet: if the file is in mm, give --units mm (it would be 100.0 mm"))
       << r.out;
   fs::remove(bar);
-  r = lamina("plan " + quoted(plate) + " --stock 0.5,1 --no-programs --out " + quoted(out.path));
+  r = lamina_cli_test::lamina("plan " + quoted(plate) + " --stock 0.5,1 --no-programs --out " + quoted(out.path));
   EXPECT_EQ(r.exit_code, 0) << r.out;
   EXPECT_FALSE(has_text(r, "--units")) << "a 120 mm plate in mm is plausible:\n" << r.out;
   fs::remove(tiny);
@@ -364,13 +365,13 @@ TEST(CliPlan, OverlappingShellsAreSaidByCheckAndPlan) {
   write_box_stl(two, 20, 20, 10, 10, true);
   write_box_stl(apart, 20, 20, 10);
   write_box_stl(apart, 20, 20, 10, 30, true);
-  CliRun r = lamina("check " + quoted(two));
+  CliRun r = lamina_cli_test::lamina("check " + quoted(two));
   EXPECT_EQ(r.exit_code, 0) << r.out;
   EXPECT_TRUE(has_text(r, "overlapping_shells: 2 shells overlap in 64 of 64 sections")) << r.out;
-  r = lamina("plan " + quoted(two) + " --stock 5,10 --no-programs --out " + quoted(out.path));
+  r = lamina_cli_test::lamina("plan " + quoted(two) + " --stock 5,10 --no-programs --out " + quoted(out.path));
   EXPECT_EQ(r.exit_code, 0) << r.out;
   EXPECT_TRUE(has_text(r, "overlapping_shells")) << r.out;
-  r = lamina("check " + quoted(apart));
+  r = lamina_cli_test::lamina("check " + quoted(apart));
   EXPECT_EQ(r.exit_code, 0) << r.out;
   EXPECT_FALSE(has_text(r, "overlapping_shells")) << "two shells side by side do not overlap:\n" << r.out;
   fs::remove(two);

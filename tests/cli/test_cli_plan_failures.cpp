@@ -15,6 +15,7 @@
 namespace {
 
 using namespace lamina_cli_test;
+using lamina_cli_test::lamina;  // the function, not namespace lamina (the files share a unity build)
 
 // Every entry of a folder (hidden ones too) with its bytes; folders as "<dir>".
 std::map<std::string, std::string> snapshot(const fs::path& dir) {

@@ -17,6 +17,7 @@
 namespace {
 
 using namespace lamina_cli_test;
+using lamina_cli_test::lamina;  // the function, not namespace lamina (the files share a unity build)
 using nlohmann::json;
 
 // A truncated cone, r 40 at z 0 to r 20 at z 20 (45°: bevels follow it exactly, so thick sheets

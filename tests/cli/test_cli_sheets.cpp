@@ -16,6 +16,7 @@
 namespace {
 
 using namespace lamina_cli_test;
+using lamina_cli_test::lamina;  // the function, not namespace lamina (the files share a unity build)
 using nlohmann::json;
 
 const fs::path kConfig = fs::path(LAMINA_EXAMPLES_DIR).parent_path() / "config";
@@ -27,7 +28,7 @@ std::string slurp(const fs::path& p) {
   return s.str();
 }
 
-bool has_text(const CliRun& r, const std::string& s) { return r.out.find(s) != std::string::npos; }
+bool sheets_have_text(const CliRun& r, const std::string& s) { return r.out.find(s) != std::string::npos; }
 
 TEST(CliSheets, PlanWritesOneProgramAndOneDrawingPerSheetAndReportsThem) {
   TempDir out("sheets");
@@ -74,7 +75,7 @@ TEST(CliSheets, PlanWritesOneProgramAndOneDrawingPerSheetAndReportsThem) {
   }
   // Every part of every layer is on a sheet: the knob has one part per layer.
   EXPECT_EQ(numbered.size(), j["layers"].size());
-  EXPECT_TRUE(has_text(r, "sheet-1.nc") || has_text(r, "sheet-<n>.nc"));
+  EXPECT_TRUE(sheets_have_text(r, "sheet-1.nc") || sheets_have_text(r, "sheet-<n>.nc"));
 }
 
 TEST(CliSheets, NotEnoughSheetsIsAClearError) {
@@ -85,8 +86,8 @@ TEST(CliSheets, NotEnoughSheetsIsAClearError) {
   const auto r = lamina("plan " + quoted(kKnob) + " --stock-file " + quoted(stock) + " --out " + quoted(out.path));
   fs::remove(stock);
   EXPECT_EQ(r.exit_code, 1) << r.out;
-  EXPECT_TRUE(has_text(r, "2.5")) << r.out;
-  EXPECT_TRUE(has_text(r, "sheet")) << r.out;
+  EXPECT_TRUE(sheets_have_text(r, "2.5")) << r.out;
+  EXPECT_TRUE(sheets_have_text(r, "sheet")) << r.out;
   EXPECT_FALSE(fs::exists(out.path / "report.json"));
 }
 
@@ -96,12 +97,12 @@ TEST(CliSheets, MachineFileErrorsNameTheLineAndKey) {
   std::ofstream(machine) << "[head]\npivot_mm = 150\n\n[cutting]\nkerf_mn = 0.9\n";
   auto r = lamina("plan " + quoted(kKnob) + " --machine " + quoted(machine) + " --out " + quoted(out.path));
   EXPECT_EQ(r.exit_code, 1) << r.out;
-  EXPECT_TRUE(has_text(r, ":5:")) << r.out;
-  EXPECT_TRUE(has_text(r, "kerf_mn")) << r.out;
+  EXPECT_TRUE(sheets_have_text(r, ":5:")) << r.out;
+  EXPECT_TRUE(sheets_have_text(r, "kerf_mn")) << r.out;
   std::ofstream(machine) << "[post]\ndialect = \"heidenhain\"\n";
   r = lamina("plan " + quoted(kKnob) + " --machine " + quoted(machine) + " --out " + quoted(out.path));
   EXPECT_EQ(r.exit_code, 1) << r.out;
-  EXPECT_TRUE(has_text(r, "heidenhain")) << r.out;
+  EXPECT_TRUE(sheets_have_text(r, "heidenhain")) << r.out;
   fs::remove(machine);
   EXPECT_FALSE(fs::exists(out.path / "report.json"));
 }
@@ -110,11 +111,11 @@ TEST(CliSheets, GrblhalWithRtcpAndUnknownMaterialAreRefused) {
   TempDir out("refused");
   auto r = lamina("plan " + quoted(kKnob) + " --post grblhal --rtcp true --out " + quoted(out.path));
   EXPECT_NE(r.exit_code, 0) << r.out;
-  EXPECT_TRUE(has_text(r, "RTCP") || has_text(r, "rtcp") || has_text(r, "G43.4")) << r.out;
+  EXPECT_TRUE(sheets_have_text(r, "RTCP") || sheets_have_text(r, "rtcp") || sheets_have_text(r, "G43.4")) << r.out;
   r = lamina("plan " + quoted(kKnob) + " --material unobtainium --out " + quoted(out.path));
   EXPECT_EQ(r.exit_code, 2) << r.out;
-  EXPECT_TRUE(has_text(r, "unobtainium")) << r.out;
-  EXPECT_TRUE(has_text(r, "aluminium 6061-T6")) << r.out;  // the known names are listed
+  EXPECT_TRUE(sheets_have_text(r, "unobtainium")) << r.out;
+  EXPECT_TRUE(sheets_have_text(r, "aluminium 6061-T6")) << r.out;  // the known names are listed
 }
 
 // laminad reads these lines from a pipe to show planning as steps.

@@ -40,6 +40,16 @@ TEST_P(CliStepModels, PlansEndToEnd) {
   }
   EXPECT_TRUE(fs::exists(out.path / "stack.stl"));
   EXPECT_EQ(r.out.find("ISO-10303"), std::string::npos) << "OCCT printed nothing of its own";
+  // What the file told the plan: tessellated to a tenth of the tolerance, exact normals, and as
+  // many faces by kind as by solid.
+  const json& cad = j["model"]["cad"];
+  EXPECT_DOUBLE_EQ(cad["chord_tolerance_mm"].get<double>(), j["settings"]["tolerance_mm"].get<double>() / 10);
+  EXPECT_EQ(cad["surface_normals"], "exact");
+  std::int64_t by_kind = 0, by_solid = 0;
+  for (const auto& [kind, faces] : cad["surface_kinds"].items()) by_kind += faces.get<std::int64_t>();
+  for (const json& s : cad["solids"]) by_solid += s["faces"].get<std::int64_t>();
+  EXPECT_EQ(by_kind, by_solid);
+  EXPECT_GT(by_kind, 0);
 }
 
 // The metre-sized elbow (1016 mm high) is left out: see docs/step.md.
@@ -60,7 +70,13 @@ TEST(CliStep, CheckJsonIsCleanAndNamesTheUnit) {
   ASSERT_EQ(r.exit_code, 0) << r.out;
   EXPECT_EQ(r.out.find("****"), std::string::npos) << "nothing of OCCT's own on stdout: " << r.out;
   const json j = json::parse(slurp(out.path / "check.json"));
-  EXPECT_NE(j.dump().find("INCH"), std::string::npos) << j.dump();
+  // The shared models' README: inch, one solid of 96 faces (49 plane, 46 cylinder, 1 B-spline).
+  EXPECT_EQ(j["cad"]["length_unit"], "INCH") << j.dump();
+  EXPECT_EQ(j["cad"]["surface_kinds"], (json{{"plane", 49}, {"cylinder", 46}, {"bspline", 1}}));
+  ASSERT_EQ(j["cad"]["solids"].size(), 1u);
+  EXPECT_EQ(j["cad"]["solids"][0]["faces"], 96);
+  EXPECT_EQ(j["cad"]["chord_tolerance_mm"], 0.02) << "check's default chord";
+  EXPECT_NE(r.out.find("B-rep      1 solid, 96 faces (plane 49, cylinder 46, bspline 1); unit INCH"), std::string::npos) << r.out;
   EXPECT_EQ(lamina("check --units in " + quoted(model)).exit_code != 0, true) << "--units is for meshes";
 }
 

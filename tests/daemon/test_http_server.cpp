@@ -18,7 +18,7 @@ namespace {
 
 using lamina::sim::testing::TempDir;
 
-const std::string kJob = "j-1764892800123-a3f9";
+const std::string kServerJob = "j-1764892800123-a3f9";
 
 void write_file(const std::filesystem::path& p, const std::string& text) {
   std::filesystem::create_directories(p.parent_path());
@@ -29,7 +29,7 @@ void write_file(const std::filesystem::path& p, const std::string& text) {
 struct Web {
   TempDir dir;
   std::filesystem::path console = std::filesystem::path(dir.file("web"));
-  std::filesystem::path job_dir = std::filesystem::path(dir.file("jobs")) / kJob;
+  std::filesystem::path job_dir = std::filesystem::path(dir.file("jobs")) / kServerJob;
   boost::asio::io_context io;
   boost::asio::executor_work_guard<boost::asio::io_context::executor_type> work{io.get_executor()};
   std::unique_ptr<HttpServer> server;
@@ -45,7 +45,7 @@ struct Web {
     s.port = 0;
     s.static_dir = console;
     server = std::make_unique<HttpServer>(io, s, [this](const ArtefactRequest& r) -> std::expected<std::filesystem::path, RouteError> {
-      if (r.job_id != kJob) return std::unexpected(RouteError{404, "no job " + r.job_id});
+      if (r.job_id != kServerJob) return std::unexpected(RouteError{404, "no job " + r.job_id});
       const auto p = job_dir / artefact_file_name(r);
       if (!std::filesystem::exists(p)) return std::unexpected(RouteError{404, "not yet written"});
       return p;
@@ -83,14 +83,14 @@ TEST(HttpServer, ServesTheConsolesFilesWithTheirTypes) {
 
 TEST(HttpServer, AJobsArtefactsAndNothingBesideThem) {
   Web web;
-  const std::string svg = get(web.port(), "/api/jobs/" + kJob + "/sheet-1.svg");
+  const std::string svg = get(web.port(), "/api/jobs/" + kServerJob + "/sheet-1.svg");
   EXPECT_EQ(status_of(svg), 200) << svg;
   EXPECT_EQ(body_of(svg), "<svg/>");
   EXPECT_NE(svg.find("image/svg+xml"), std::string::npos);
-  EXPECT_EQ(status_of(get(web.port(), "/api/jobs/" + kJob + "/sheet-2.svg")), 404);  // not written
+  EXPECT_EQ(status_of(get(web.port(), "/api/jobs/" + kServerJob + "/sheet-2.svg")), 404);  // not written
   EXPECT_EQ(status_of(get(web.port(), "/api/jobs/j-1764892800123-0000/report.json")), 404);
-  for (const std::string& attack : std::vector<std::string>{"/api/jobs/" + kJob + "/../jobs.db", "/api/jobs/../jobs.db",
-                                   "/../jobs/jobs.db", "/%2e%2e/jobs/jobs.db", "/api/jobs/" + kJob + "/..%2fjobs.db"}) {
+  for (const std::string& attack : std::vector<std::string>{"/api/jobs/" + kServerJob + "/../jobs.db", "/api/jobs/../jobs.db",
+                                   "/../jobs/jobs.db", "/%2e%2e/jobs/jobs.db", "/api/jobs/" + kServerJob + "/..%2fjobs.db"}) {
     const std::string r = get(web.port(), attack);
     EXPECT_EQ(status_of(r), 400) << attack << ": " << r;
     EXPECT_EQ(r.find("secret"), std::string::npos) << attack;

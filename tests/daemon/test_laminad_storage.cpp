@@ -10,7 +10,7 @@
 namespace lamina::daemon::testing {
 namespace {
 
-const std::string kModel = std::string(LAMINA_EXAMPLES_DIR) + "/knob.stl";
+const std::string kStorageModel = std::string(LAMINA_EXAMPLES_DIR) + "/knob.stl";
 
 Json machine_status(RpcClient& c) { return call_ok(c, "machine.status"); }
 
@@ -46,7 +46,7 @@ TEST(LaminadStorage, ADiskFullWhileCuttingStopsTheCutAndNothingRunsAheadOfTheDis
 
   // Requests that would write are refused, with the code and the way out.
   for (const auto& [method, params] : std::vector<std::pair<std::string, Json>>{
-           {"job.resume", {{"job", id}}}, {"job.submit", {{"model", kModel}}}, {"job.cancel", {{"job", id}}}}) {
+           {"job.resume", {{"job", id}}}, {"job.submit", {{"model", kStorageModel}}}, {"job.cancel", {{"job", id}}}}) {
     auto r = c.call(method, params);
     ASSERT_FALSE(r) << method;
     EXPECT_EQ(r.error().code, -32014) << method;
@@ -79,7 +79,7 @@ TEST(LaminadStorage, ADeletedDatabaseIsNoticedAndRefused) {
   std::filesystem::remove(cell.dir.file("state/lamina.db"));
   ASSERT_TRUE(wait_store_failed(c, 5));
   EXPECT_NE(machine_status(c)["store"]["error"].get<std::string>().find("deleted"), std::string::npos);
-  auto r = c.call("job.submit", {{"model", kModel}});
+  auto r = c.call("job.submit", {{"model", kStorageModel}});
   ASSERT_FALSE(r);
   EXPECT_EQ(r.error().code, -32014);
   EXPECT_TRUE(call_ok(c, "job.list").empty());

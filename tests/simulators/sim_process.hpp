@@ -13,6 +13,7 @@
 #include <arpa/inet.h>
 #include <netinet/in.h>
 
+#include <algorithm>
 #include <chrono>
 #include <csignal>
 #include <cstdint>
@@ -58,9 +59,21 @@ class TempDir {
   std::filesystem::path path_;
 };
 
+// Every simulator a test starts runs paced to the host (--pace-to-host, host_pacer.hpp) unless the
+// test says --no-pace-to-host: a test that streams to a compressed machine must not depend on the
+// CI machine keeping its host scheduled (a drip feed at 2x starved under load, 2026-12-06). At a
+// time scale of 1 pacing changes nothing; the tests of starvation itself say --no-pace-to-host.
+inline std::vector<std::string> paced_by_default(std::vector<std::string> args) {
+  if (std::find(args.begin(), args.end(), "--no-pace-to-host") == args.end() &&
+      std::find(args.begin(), args.end(), "--pace-to-host") == args.end())
+    args.push_back("--pace-to-host");
+  return args;
+}
+
 class SimProcess {
  public:
   explicit SimProcess(std::vector<std::string> args) {
+    args = paced_by_default(std::move(args));
     int out[2];
     if (::pipe(out) != 0) throw std::runtime_error("pipe failed");
     std::vector<char*> argv;

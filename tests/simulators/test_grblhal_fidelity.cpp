@@ -17,8 +17,8 @@ namespace {
 using test::count_of;
 using test::ProtocolHarness;
 
-struct Grbl : ProtocolHarness {
-  explicit Grbl(MachineConfig config = {}, GrblParams params = {}) : ProtocolHarness(std::move(config)) {
+struct FidelityGrbl : ProtocolHarness {
+  explicit FidelityGrbl(MachineConfig config = {}, GrblParams params = {}) : ProtocolHarness(std::move(config)) {
     protocol = make_grbl_protocol(machine, params);
     protocol->on_connect(now_s);
     take();  // the banner
@@ -44,7 +44,7 @@ std::string field(const std::string& report, const std::string& name) {
 // after it (mc_dwell: protocol_buffer_synchronize, then delay_sec) ---
 
 TEST(GrblHalFidelity, DwellAnswersOkOnlyWhenItEndsAndReportsIdleWithEveryBlockFree) {
-  Grbl g;
+  FidelityGrbl g;
   g.send("G1X10F600\nG4P3\nG1X20\n");  // 1 s of motion, then 3 s of dwell
   EXPECT_EQ(count_of(g.take(), "ok"), 1) << "the dwell waits for the motion before it";
   g.run_for(2.0);  // 1 s into the dwell
@@ -62,7 +62,7 @@ TEST(GrblHalFidelity, DwellAnswersOkOnlyWhenItEndsAndReportsIdleWithEveryBlockFr
 }
 
 TEST(GrblHalFidelity, FeedHoldPausesADwellAndItsOk) {
-  Grbl g;
+  FidelityGrbl g;
   g.send("G4P2\n");
   g.run_for(0.5);
   g.send("!");
@@ -77,7 +77,7 @@ TEST(GrblHalFidelity, FeedHoldPausesADwellAndItsOk) {
 }
 
 TEST(GrblHalFidelity, ResetDuringADwellDropsItsLineUnanswered) {
-  Grbl g;
+  FidelityGrbl g;
   g.send("G4P2\nG0X5\n");
   g.run_for(0.5);
   g.send("\x18");
@@ -90,7 +90,7 @@ TEST(GrblHalFidelity, ResetDuringADwellDropsItsLineUnanswered) {
 }
 
 TEST(GrblHalFidelity, TheExecutionLogListsADwellOnceWhenItEnds) {
-  Grbl g;
+  FidelityGrbl g;
   g.send("G0X10\nG4P1\nM3\nG1X20F600\nM5\nM30\n");
   g.run_for(5.0);
   const std::vector<std::string> expected{"G0X10", "G4P1", "M3", "G1X20F600", "M5", "M30"};
@@ -101,13 +101,13 @@ TEST(GrblHalFidelity, TheExecutionLogListsADwellOnceWhenItEnds) {
 // --- Bf: the receive field is at most size − 1 (serialRxFree), [OPT:] still names the size ---
 
 TEST(GrblHalFidelity, ReceiveBufferReportsSizeMinusOneFreeAndOptTheSize) {
-  Grbl g;
+  FidelityGrbl g;
   EXPECT_EQ(field(g.status(), "Bf"), "100,1023");
   g.send("$I\n");
   EXPECT_NE(g.take().find("[OPT:VNL,100,1024,5,0]"), std::string::npos);
   GrblParams small;
   small.rx_buffer_bytes = 16;
-  Grbl s({}, small);
+  FidelityGrbl s({}, small);
   s.send_burst("G1X1234567890123");  // 16 bytes, no end of line: the 16th is lost
   EXPECT_EQ(s.protocol->counters().bytes_received, 15u);
   EXPECT_EQ(s.protocol->counters().bytes_dropped, 1u);
@@ -116,7 +116,7 @@ TEST(GrblHalFidelity, ReceiveBufferReportsSizeMinusOneFreeAndOptTheSize) {
 // --- M2 / M30: [MSG:Pgm End] before the ok (gc_execute_block, Message_ProgramEnd) ---
 
 TEST(GrblHalFidelity, ProgramEndSaysPgmEndThenOk) {
-  Grbl g;
+  FidelityGrbl g;
   g.send("M30\n");
   EXPECT_EQ(g.take(), "[MSG:Pgm End]\r\nok\r\n");
   g.send("G1X1F600\nM2\n");
@@ -128,7 +128,7 @@ TEST(GrblHalFidelity, ProgramEndSaysPgmEndThenOk) {
 // --- M3/M4/M5, M7/M8/M9: accepted without S, shown in the accessory field A: ---
 
 TEST(GrblHalFidelity, SpindleAndCoolantShowInTheAccessoryField) {
-  Grbl g;
+  FidelityGrbl g;
   g.status();  // the first report after the banner carries Ov (and A: with it)
   g.send("M3\n");
   EXPECT_EQ(g.take(), "ok\r\n") << "M3 without S";
@@ -155,7 +155,7 @@ TEST(GrblHalFidelity, SpindleAndCoolantShowInTheAccessoryField) {
 // then "[Unused words]") ---
 
 TEST(GrblHalFidelity, BWordOnAnXyzacMachineIsErrorThirtySix) {
-  Grbl g;
+  FidelityGrbl g;
   g.send("G1X1B10F100\n");
   EXPECT_EQ(g.take(), "error:36\r\n");
   Machine m({});
@@ -166,13 +166,13 @@ TEST(GrblHalFidelity, BWordOnAnXyzacMachineIsErrorThirtySix) {
 // --- M7 M8 M9 M4, G53, G28: accepted, and they do what grblHAL does ---
 
 TEST(GrblHalFidelity, CoolantAndCounterClockwiseSpindleCodesAreAccepted) {
-  Grbl g;
+  FidelityGrbl g;
   g.send("M7\nM8\nM9\nM4\nM5\n");
   EXPECT_EQ(g.take(), "ok\r\nok\r\nok\r\nok\r\nok\r\n");
 }
 
 TEST(GrblHalFidelity, G53MovesInMachineCoordinatesEvenInIncrementalMode) {
-  Grbl g;
+  FidelityGrbl g;
   g.send("G0X10\nG91\nG53G0X50Y5\nG0X1\n");
   EXPECT_EQ(g.take(), "ok\r\nok\r\nok\r\nok\r\n");
   g.run_for(1.0);
@@ -231,7 +231,7 @@ TEST(GrblHalFidelity, ArcFormsGrblHalAccepts) {
 // --- Status fields: WCO and Ov every N reports (report.c's counters), A: with Ov or on change ---
 
 TEST(GrblHalFidelity, WcoAndOverridesComeEveryFewReportsAsGrblHalCountsThem) {
-  Grbl g;
+  FidelityGrbl g;
   std::vector<std::string> reports;
   for (int i = 0; i < 23; ++i) reports.push_back(g.status());
   auto has = [&](int n, const char* name) { return field(reports[static_cast<std::size_t>(n - 1)], name) != "<none>"; };
@@ -257,7 +257,7 @@ TEST(GrblHalFidelity, WcoAndOverridesComeEveryFewReportsAsGrblHalCountsThem) {
 }
 
 TEST(GrblHalFidelity, AccessoriesRideWithTheOverridesAndProgramEndFlagsWco) {
-  Grbl g;
+  FidelityGrbl g;
   g.send("M3\n");
   g.take();
   const std::string first = g.status();

@@ -20,7 +20,7 @@
 namespace lamina::sim {
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180.0;
+constexpr double kRadPerDeg = std::numbers::pi / 180.0;
 
 TEST(JetHead, KnownPoses) {
   const HeadGeometry head;  // pivot 150, signs +1, no offset, pivot coordinates
@@ -35,7 +35,7 @@ TEST(JetHead, KnownPoses) {
   p = jet_pose({18, 0, -20.096, 30, 0}, head);
   EXPECT_NEAR(p.axis[0], 0, 1e-12);
   EXPECT_NEAR(p.axis[1], -0.5, 1e-12);
-  EXPECT_NEAR(p.axis[2], std::cos(30 * kDeg), 1e-12);
+  EXPECT_NEAR(p.axis[2], std::cos(30 * kRadPerDeg), 1e-12);
   EXPECT_NEAR(p.tip_mm[1], 75, 1e-9);
   EXPECT_NEAR(p.tip_mm[2], 0, 1e-3);
   // C = 90 turns the lean towards +X; a negative a_sign reverses it.
@@ -75,7 +75,7 @@ TEST(JetHead, ACouponLaminaPostedCutsWhereItSays) {
     if (std::abs(end.tip_mm[0] - start.tip_mm[0]) < 39.0) continue;  // lead-ins and lead-outs
     ++cuts;
     EXPECT_NEAR(end.tip_mm[1], start.tip_mm[1], 1e-3) << b->line << ": a straight slot along x";
-    tilt_at_y[std::lround(end.tip_mm[1])] = std::acos(end.axis[2]) / kDeg;
+    tilt_at_y[std::lround(end.tip_mm[1])] = std::acos(end.axis[2]) / kRadPerDeg;
   }
   EXPECT_EQ(cuts, 10);
   ASSERT_EQ(tilt_at_y.size(), 10u);
@@ -101,7 +101,7 @@ TEST(JetPhysics, TheSimulatedJetsShape) {
   EXPECT_LT(fast.bottom_width_mm, fast.top_width_mm) << "V";
   EXPECT_GT(slow.top_width_mm, fast.top_width_mm) << "wider when slow";
   EXPECT_LT(slow.trail_back_mm, fast.trail_back_mm);
-  EXPECT_NEAR(cut_wall(jet, 10.0, 100 * 25.0).trail_back_mm, 10.0 * std::tan(jet.lag_max_deg * kDeg), 1e-6) << "saturates";
+  EXPECT_NEAR(cut_wall(jet, 10.0, 100 * 25.0).trail_back_mm, 10.0 * std::tan(jet.lag_max_deg * kRadPerDeg), 1e-6) << "saturates";
   EXPECT_EQ(cut_wall(jet, 10.0, 3 * 25.0).bottom_width_mm, 0.0) << "not through";
   // A longer path is slower to separate: the same feed is a larger ratio there.
   EXPECT_GT(cut_wall(jet, 20.0, 10.0).trail_back_mm, 2 * cut_wall(jet, 10.0, 10.0).trail_back_mm);

@@ -25,7 +25,7 @@ std::vector<ExecutedBlock> executed(const std::vector<MachineEvent>& events) {
   return out;
 }
 
-void ok(Machine& m, std::string_view line, double t_s) { ASSERT_EQ(m.submit_line(line, t_s), GrblStatus::ok) << line; }
+void submit_ok(Machine& m, std::string_view line, double t_s) { ASSERT_EQ(m.submit_line(line, t_s), GrblStatus::ok) << line; }
 
 // The host's side of the contract (written here again: the simulator links nothing from
 // drivers/): of `accepted` program lines, the last `queued` moves (the running one included)
@@ -49,7 +49,7 @@ TEST(MachinePlannerCapacity, CommentsBetweenMovesTakeNoCapacityAndAreLoggedWhenR
   }
   program.push_back("M30");
   std::size_t next = 0;
-  for (; next < program.size() && m.has_room_for(program[next]); ++next) ok(m, program[next], 0);
+  for (; next < program.size() && m.has_room_for(program[next]); ++next) submit_ok(m, program[next], 0);
   // Four moves fill the planner; every line before the fifth move got in.
   EXPECT_EQ(m.free_blocks(), 0u);
   EXPECT_EQ(m.queued_timed_blocks(), 4u);
@@ -59,7 +59,7 @@ TEST(MachinePlannerCapacity, CommentsBetweenMovesTakeNoCapacityAndAreLoggedWhenR
   while (next < program.size()) {
     t += 0.25;
     m.advance(t);
-    for (; next < program.size() && m.has_room_for(program[next]); ++next) ok(m, program[next], t);
+    for (; next < program.size() && m.has_room_for(program[next]); ++next) submit_ok(m, program[next], t);
     EXPECT_EQ(first_unfinished(program, next, 4 - m.free_blocks()), m.executed_blocks()) << "t " << t;
   }
   m.advance(100);
@@ -77,15 +77,15 @@ TEST(MachinePlannerCapacity, SoftLimitAlarmsEvenWithThePlannerFull) {
   MachineConfig config;
   config.planner_blocks = 1;
   Machine m(config);
-  ok(m, "G1X10F600", 0);
+  submit_ok(m, "G1X10F600", 0);
   EXPECT_TRUE(m.has_room_for("G0X5000"));  // grblHAL checks the target before waiting for a block
   EXPECT_EQ(m.submit_line("G0X5000", 0), GrblStatus::soft_limit);
   ASSERT_TRUE(m.alarm().has_value());
   EXPECT_EQ(*m.alarm(), GrblAlarm::soft_limit);
 }
 
-struct Grbl : ProtocolHarness {
-  explicit Grbl(std::size_t planner_blocks) : ProtocolHarness(config(planner_blocks)) {
+struct CapacityGrbl : ProtocolHarness {
+  explicit CapacityGrbl(std::size_t planner_blocks) : ProtocolHarness(config(planner_blocks)) {
     protocol = make_grbl_protocol(machine, {});
     protocol->on_connect(now_s);
     take();
@@ -109,7 +109,7 @@ struct Grbl : ProtocolHarness {
 };
 
 TEST(GrblPlannerCapacity, BfCountsOnlyTheMoves) {
-  Grbl g(4);
+  CapacityGrbl g(4);
   std::string text = "G21\nG94\nM3\nG1 X10 F600\n";
   for (int i = 0; i < 10; ++i) text += "(note)\n";
   g.send(text + "G1 X20\n;\n");
@@ -119,7 +119,7 @@ TEST(GrblPlannerCapacity, BfCountsOnlyTheMoves) {
 }
 
 TEST(GrblPlannerCapacity, CommentsAreAcknowledgedOnceTheMoveBeforeThemHasABlock) {
-  Grbl g(4);
+  CapacityGrbl g(4);
   // 1 s per move (10 mm at 10 mm/s); ten comments after the 4th move and after the 5th.
   std::vector<std::string> program{"G1 X10 F600", "G1 X20", "G1 X30", "G1 X40"};
   for (int i = 0; i < 10; ++i) program.push_back("(after 4, " + std::to_string(i) + ")");
@@ -146,7 +146,7 @@ TEST(GrblPlannerCapacity, CommentsAreAcknowledgedOnceTheMoveBeforeThemHasABlock)
 }
 
 TEST(GrblPlannerCapacity, BfTellsTheHostHowFarTheMachineGot) {
-  Grbl g(4);
+  CapacityGrbl g(4);
   std::vector<std::string> program{"G21", "G90", "G94", "M3"};
   for (int i = 1; i <= 12; ++i) {
     program.push_back("(CONTOUR " + std::to_string(i) + ")");
@@ -173,7 +173,7 @@ TEST(GrblPlannerCapacity, BfTellsTheHostHowFarTheMachineGot) {
 }
 
 struct XonXoff : ProtocolHarness {
-  explicit XonXoff(std::size_t planner_blocks) : ProtocolHarness(Grbl::config(planner_blocks)) {
+  explicit XonXoff(std::size_t planner_blocks) : ProtocolHarness(CapacityGrbl::config(planner_blocks)) {
     protocol = make_xonxoff_protocol(machine, {});
   }
 };

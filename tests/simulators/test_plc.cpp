@@ -20,7 +20,7 @@ PlcConfig test_config() {
 }
 
 // A client write: set coils/holding as a Modbus write would, then tell the PLC.
-struct Cell {
+struct PlcCell {
   Plc plc{test_config()};
   double now = 0;
   CncSnapshot cnc;
@@ -62,7 +62,7 @@ struct Cell {
 };
 
 TEST(Plc, PowerOnState) {
-  Cell cell;
+  PlcCell cell;
   EXPECT_EQ(cell.r().holding[mm::kHoldPressureSetpoint], 3800);
   EXPECT_EQ(cell.r().holding[mm::kHoldAbrasiveSetpoint], 350);
   EXPECT_TRUE(cell.input(mm::kInputEstopOk));
@@ -74,7 +74,7 @@ TEST(Plc, PowerOnState) {
 }
 
 TEST(Plc, PressureRampsLinearlyAndPumpReadyAtTheFraction) {
-  Cell cell;
+  PlcCell cell;
   cell.plc.tick(0, cell.cnc);
   cell.coil(mm::kCoilPumpEnable, true);
   cell.run_to(1.0);
@@ -96,7 +96,7 @@ TEST(Plc, PressureRampsLinearlyAndPumpReadyAtTheFraction) {
 }
 
 TEST(Plc, SetpointChangeRetargetsThePressure) {
-  Cell cell;
+  PlcCell cell;
   cell.ready_to_cut();
   cell.hold(mm::kHoldPressureSetpoint, 2000);
   cell.run_to(cell.now + 2.0);
@@ -107,7 +107,7 @@ TEST(Plc, SetpointChangeRetargetsThePressure) {
 }
 
 TEST(Plc, AbrasiveFollowsItsCoilAndEmptiesTheHopper) {
-  Cell cell;
+  PlcCell cell;
   cell.plc.tick(0, cell.cnc);
   cell.hold(mm::kHoldAbrasiveSetpoint, 1000);  // 1 kg/min
   EXPECT_EQ(cell.in_reg(mm::kInAbrasiveFlow), 0);
@@ -126,7 +126,7 @@ TEST(Plc, AbrasiveFollowsItsCoilAndEmptiesTheHopper) {
 }
 
 TEST(Plc, JetNeedsEveryCondition) {
-  Cell cell;
+  PlcCell cell;
   cell.ready_to_cut();
   ASSERT_TRUE(cell.input(mm::kInputJetIsOn));
   ASSERT_TRUE(cell.plc.jet_is_on());
@@ -154,7 +154,7 @@ TEST(Plc, JetNeedsEveryCondition) {
 }
 
 TEST(Plc, CncJetRequestIsReportedNotObeyed) {
-  Cell cell;
+  PlcCell cell;
   cell.cnc.jet_request = true;
   cell.plc.tick(0, cell.cnc);
   EXPECT_TRUE(cell.input(mm::kInputCncJetRequest));
@@ -162,7 +162,7 @@ TEST(Plc, CncJetRequestIsReportedNotObeyed) {
 }
 
 TEST(Plc, EstopLatchesAndStopsThePump) {
-  Cell cell;
+  PlcCell cell;
   cell.ready_to_cut();
   cell.coil(mm::kCoilSimEstop, true);
   EXPECT_TRUE(cell.plc.estop_pressed());
@@ -190,7 +190,7 @@ TEST(Plc, EstopLatchesAndStopsThePump) {
 }
 
 TEST(Plc, EstopThroughTheSetterLatchesAtOnce) {
-  Cell cell;
+  PlcCell cell;
   cell.plc.set_estop(true);
   EXPECT_EQ(cell.plc.alarm_code(), mm::kAlarmEstop);
   EXPECT_EQ(cell.r().coils[mm::kCoilSimEstop], 1);
@@ -200,7 +200,7 @@ TEST(Plc, EstopThroughTheSetterLatchesAtOnce) {
 }
 
 TEST(Plc, PressureDropTakesPumpReadyAway) {
-  Cell cell;
+  PlcCell cell;
   cell.ready_to_cut();
   cell.coil(mm::kCoilSimPressureDrop, true);
   cell.run_to(cell.now + 0.2);
@@ -215,7 +215,7 @@ TEST(Plc, PressureDropTakesPumpReadyAway) {
 }
 
 TEST(Plc, StallIsACoilTheCncReads) {
-  Cell cell;
+  PlcCell cell;
   EXPECT_FALSE(cell.plc.stall());
   cell.coil(mm::kCoilSimStall, true);
   EXPECT_TRUE(cell.plc.stall());
@@ -224,7 +224,7 @@ TEST(Plc, StallIsACoilTheCncReads) {
 }
 
 TEST(Plc, HeartbeatWatchdogIsArmedByTheFirstChange) {
-  Cell cell;
+  PlcCell cell;
   cell.ready_to_cut();
   cell.run_to(cell.now + 5.0);  // never written: not supervised
   EXPECT_TRUE(cell.input(mm::kInputJetIsOn));
@@ -245,7 +245,7 @@ TEST(Plc, HeartbeatWatchdogIsArmedByTheFirstChange) {
 // next sheet).
 TEST(Plc, HeartbeatTimeoutHoldsACncInItsCycleOnly) {
   for (const bool cutting : {true, false}) {
-    Cell cell;
+    PlcCell cell;
     cell.ready_to_cut();
     cell.cnc.state = cutting ? 1 : 0;
     cell.cnc.jet_request = cutting;
@@ -257,7 +257,7 @@ TEST(Plc, HeartbeatTimeoutHoldsACncInItsCycleOnly) {
 }
 
 TEST(Plc, HeartbeatTimeoutLatchesAndResetNeedsHeartbeatsBack) {
-  Cell cell;
+  PlcCell cell;
   cell.ready_to_cut();
   cell.hold(mm::kHoldHeartbeat, 1);
   const double beat_s = cell.now;
@@ -299,7 +299,7 @@ TEST(Plc, ZeroTimeoutDisablesTheWatchdog) {
 }
 
 TEST(Plc, FirstAlarmIsShownUntilItsCauseIsCleared) {
-  Cell cell;
+  PlcCell cell;
   cell.ready_to_cut();
   cell.hold(mm::kHoldHeartbeat, 1);
   cell.coil(mm::kCoilSimEstop, true);
@@ -312,7 +312,7 @@ TEST(Plc, FirstAlarmIsShownUntilItsCauseIsCleared) {
 }
 
 TEST(Plc, MailboxDecodesABlock) {
-  Cell cell;
+  PlcCell cell;
   EXPECT_FALSE(cell.plc.pending_block());
   cell.submit(1, "G1 X10.5 Y-3 F1200");  // odd length: the last character in a high byte
   auto block = cell.plc.pending_block();
@@ -343,7 +343,7 @@ TEST(Plc, MailboxDecodesABlock) {
 }
 
 TEST(Plc, MailboxOverrunLatchesAndKeepsTheFirstBlock) {
-  Cell cell;
+  PlcCell cell;
   cell.submit(1, "G0 X1");
   cell.submit(2, "G0 X2");
   EXPECT_EQ(cell.plc.alarm_code(), mm::kAlarmMailboxOverrun);
@@ -355,7 +355,7 @@ TEST(Plc, MailboxOverrunLatchesAndKeepsTheFirstBlock) {
 }
 
 TEST(Plc, MailboxRefusesBadBlocks) {
-  Cell cell;
+  PlcCell cell;
   cell.r().holding[mm::kHoldMailboxLength] = 201;
   cell.hold(mm::kHoldMailboxSeq, 1);
   EXPECT_FALSE(cell.plc.pending_block());
@@ -375,12 +375,12 @@ TEST(Plc, MailboxRefusesBadBlocks) {
   EXPECT_EQ(cell.in_reg(mm::kInMailboxAck), 0);
 }
 
-std::int32_t read_i32(Cell& cell, int high) {
+std::int32_t read_i32(PlcCell& cell, int high) {
   return static_cast<std::int32_t>((std::uint32_t{cell.in_reg(high)} << 16) | cell.in_reg(high + 1));
 }
 
 TEST(Plc, SnapshotEncoding) {
-  Cell cell;
+  PlcCell cell;
   cell.cnc.state = 1;
   cell.cnc.executed_blocks = 70000;  // > 16 bits
   cell.cnc.position[0] = 1234.5674;
@@ -412,7 +412,7 @@ TEST(Plc, SnapshotEncoding) {
 }
 
 TEST(Plc, CncButtonsArePushButtonsTakenOnce) {
-  Cell cell;
+  PlcCell cell;
   cell.coil(mm::kCoilCncFeedHold, true);
   EXPECT_EQ(cell.r().coils[mm::kCoilCncFeedHold], 0) << "the PLC releases the button at once";
   cell.run_to(0.1);  // a scan in between does not lose the press
@@ -436,7 +436,7 @@ TEST(Plc, CncButtonsArePushButtonsTakenOnce) {
 // Two writes in one scan, hold then reset: the reset machine must not come back held (a held
 // drip feed would then hold its next program's bytes for ever).
 TEST(Plc, ResetSpendsAHoldPressedBeforeItInTheSameScan) {
-  Cell cell;
+  PlcCell cell;
   cell.coil(mm::kCoilCncFeedHold, true);
   cell.coil(mm::kCoilCncReset, true);
   auto pressed = cell.plc.take_cnc_buttons();

@@ -252,8 +252,9 @@ TEST(SimGrblLink, StarvationIsLoggedWhenTheSenderFallsBehindAndNotWhenItKeepsUp)
     }, 30));
     EXPECT_EQ(control_status(s.sim.control_port())["starvation"], 0);
   }
-  // Falling behind: 10 ms moves sent 100 ms apart.
-  PtySim s({});
+  // Falling behind: 10 ms moves sent 100 ms apart (unpaced, though at a time scale of 1 pacing
+  // would change nothing).
+  PtySim s({"--no-pace-to-host"});
   StreamClient c = StreamClient::open_pty(s.link);
   ASSERT_TRUE(wait_controller(c));
   for (int i = 1; i <= 5; ++i) {
@@ -375,7 +376,7 @@ TEST(SimGrblLink, PacedToTheHostABriefPauseDoesNotStarveACompressedMachine) {
   EXPECT_GE(paced.slowdowns, 1u) << "the pause slowed the clock to real time";
   EXPECT_EQ(paced.executed, five_axis_program(600).size());
   // The same pause unpaced: the 50x machine runs dry (the test can fail).
-  const PausedStream unpaced = stream_with_a_pause({});
+  const PausedStream unpaced = stream_with_a_pause({"--no-pace-to-host"});
   EXPECT_GE(unpaced.starvation, 1u);
   EXPECT_EQ(unpaced.slowdowns, 0u);
 }

@@ -96,4 +96,24 @@ void write_assembly(const TopoDS_Shape& part, double dx, const std::filesystem::
   XCAFApp_Application::GetApplication()->Close(doc);
 }
 
+void write_assembly_of(const std::vector<PlacedPart>& parts, const std::filesystem::path& path) {
+  Handle(TDocStd_Document) doc;
+  XCAFApp_Application::GetApplication()->NewDocument("MDTV-XCAF", doc);
+  const Handle(XCAFDoc_ShapeTool) tool = XCAFDoc_DocumentTool::ShapeTool(doc->Main());
+  const TDF_Label assembly = tool->NewShape();
+  TDataStd_Name::Set(assembly, "assembly");
+  for (const PlacedPart& p : parts) {
+    const TDF_Label label = tool->AddShape(p.shape, Standard_False);
+    TDataStd_Name::Set(label, p.name.c_str());
+    gp_Trsf moved;
+    moved.SetTranslation(gp_Vec(p.dx, p.dy, p.dz));
+    TDataStd_Name::Set(tool->AddComponent(assembly, label, TopLoc_Location(moved)), (p.name + " 1").c_str());
+  }
+  tool->UpdateAssemblies();
+  STEPCAFControl_Writer writer;
+  if (!writer.Transfer(doc, STEPControl_AsIs) || writer.Write(path.c_str()) != IFSelect_RetDone)
+    throw std::runtime_error("STEP assembly write failed: " + path.string());
+  XCAFApp_Application::GetApplication()->Close(doc);
+}
+
 }  // namespace lamina::step_testing

@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <string>
+#include <vector>
 
 namespace lamina::step_testing {
 
@@ -20,5 +21,13 @@ TopoDS_Shape box(double x, double y, double z);
 void write_cad(const TopoDS_Shape& shape, const std::filesystem::path& path);
 // Two solids as an assembly: `part` placed twice, the second moved by (dx, 0, 0), named.
 void write_assembly(const TopoDS_Shape& part, double dx, const std::filesystem::path& path);
+
+// An assembly of distinct parts (each its own product, named), each moved by its offset (mm).
+struct PlacedPart {
+  std::string name;
+  TopoDS_Shape shape;
+  double dx = 0, dy = 0, dz = 0;
+};
+void write_assembly_of(const std::vector<PlacedPart>& parts, const std::filesystem::path& path);
 
 }  // namespace lamina::step_testing

@@ -16,18 +16,17 @@ namespace {
 
 constexpr double kMaxTiltRad = std::numbers::pi / 3.0;  // the heads we post for tilt to 60°
 
-Error bad(std::string message) { return Error{ErrorCode::invalid_argument, std::move(message)}; }
 
 std::expected<void, Error> check(const CouponParams& c) {
-  if (c.feed_ratios.empty() || c.tilts_rad.empty()) return std::unexpected(bad("coupon: needs a feed ratio and a tilt at least"));
+  if (c.feed_ratios.empty() || c.tilts_rad.empty()) return std::unexpected(invalid_argument("coupon: needs a feed ratio and a tilt at least"));
   for (double r : c.feed_ratios)
-    if (!std::isfinite(r) || r <= 0.0 || r > 2.0) return std::unexpected(bad(fmt::format("coupon: feed ratio {} must be in (0, 2]", r)));
+    if (!std::isfinite(r) || r <= 0.0 || r > 2.0) return std::unexpected(invalid_argument(fmt::format("coupon: feed ratio {} must be in (0, 2]", r)));
   for (double t : c.tilts_rad)
     if (!std::isfinite(t) || std::abs(t) > kMaxTiltRad)
-      return std::unexpected(bad(fmt::format("coupon: tilt {:.1f} deg is beyond 60 deg", t * 180.0 / std::numbers::pi)));
+      return std::unexpected(invalid_argument(fmt::format("coupon: tilt {:.1f} deg is beyond 60 deg", t * 180.0 / std::numbers::pi)));
   for (auto [name, v] : {std::pair{"thickness_mm", c.thickness_mm}, std::pair{"cut_length_mm", c.cut_length_mm},
                          std::pair{"spacing_mm", c.spacing_mm}, std::pair{"margin_mm", c.margin_mm}})
-    if (!std::isfinite(v) || v <= 0.0) return std::unexpected(bad(fmt::format("coupon: {} = {} must be > 0", name, v)));
+    if (!std::isfinite(v) || v <= 0.0) return std::unexpected(invalid_argument(fmt::format("coupon: {} = {} must be > 0", name, v)));
   return {};
 }
 

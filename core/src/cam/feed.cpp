@@ -21,12 +21,11 @@ constexpr double kSPerMin = 60.0;
 constexpr double kZengKimC = 163.0;
 constexpr double kGarnetFactor = 1.0;
 
-Error invalid(std::string message) { return {ErrorCode::invalid_argument, std::move(message)}; }
 
 // Positive and finite; the message names the parameter, its value and its unit.
 std::expected<void, Error> positive(std::string_view name, double v, std::string_view unit) {
   if (std::isfinite(v) && v > 0.0) return {};
-  return std::unexpected(invalid(fmt::format("cut feed: {} = {} {} must be a finite number > 0", name, v, unit)));
+  return std::unexpected(invalid_argument(fmt::format("cut feed: {} = {} {} must be a finite number > 0", name, v, unit)));
 }
 
 std::expected<void, Error> check_jet(const JetSetup& jet) {
@@ -38,7 +37,7 @@ std::expected<void, Error> check_jet(const JetSetup& jet) {
     if (!r) return r;
   const double cd = jet.discharge_coefficient;
   if (!(std::isfinite(cd) && cd > 0.0 && cd <= 1.0))
-    return std::unexpected(invalid(fmt::format("cut feed: jet.discharge_coefficient = {} must be in (0, 1]", cd)));
+    return std::unexpected(invalid_argument(fmt::format("cut feed: jet.discharge_coefficient = {} must be in (0, 1]", cd)));
   return {};
 }
 
@@ -46,16 +45,16 @@ std::expected<void, Error> check_jet(const JetSetup& jet) {
 std::expected<void, Error> check_model_inputs(const Material& m, const FeedParams& params) {
   if (params.model == FeedModel::limbachiya_patel) {
     if (!(std::isfinite(m.specific_energy_j_per_m3) && m.specific_energy_j_per_m3 > 0.0))
-      return std::unexpected(invalid(fmt::format(
+      return std::unexpected(invalid_argument(fmt::format(
           "cut feed: material '{}' specific_energy_j_per_m3 = {} J/m³ must be > 0 for the limbachiya_patel model", m.name,
           m.specific_energy_j_per_m3)));
     return {};
   }
   if (!(std::isfinite(m.machinability) && m.machinability > 0.0))
-    return std::unexpected(invalid(fmt::format("cut feed: material '{}' machinability = {} must be > 0 for the zeng_kim model",
+    return std::unexpected(invalid_argument(fmt::format("cut feed: material '{}' machinability = {} must be > 0 for the zeng_kim model",
                                                m.name, m.machinability)));
   if (params.quality < 1 || params.quality > 5)
-    return std::unexpected(invalid(
+    return std::unexpected(invalid_argument(
         fmt::format("cut feed: quality = {} is outside 1 (separation cut) … 5 (finest) of the zeng_kim model", params.quality)));
   return {};
 }
@@ -64,10 +63,10 @@ std::expected<void, Error> check_cut(const FeedParams& params, double thickness_
   if (auto r = positive("thickness_mm", thickness_mm, "mm"); !r) return r;
   // cos(tilt) → 0 makes the jet's path through the sheet infinite; the sign is only the lean direction.
   if (!(std::isfinite(tilt_rad) && std::abs(tilt_rad) < std::numbers::pi / 2))
-    return std::unexpected(invalid(fmt::format("cut feed: tilt_rad = {} rad must satisfy |tilt| < π/2 (90°)", tilt_rad)));
+    return std::unexpected(invalid_argument(fmt::format("cut feed: tilt_rad = {} rad must satisfy |tilt| < π/2 (90°)", tilt_rad)));
   if (auto r = positive("min_feed_mm_per_s", params.min_feed_mm_per_s, "mm/s"); !r) return r;
   if (!(std::isfinite(params.max_feed_mm_per_s) && params.max_feed_mm_per_s >= params.min_feed_mm_per_s))
-    return std::unexpected(invalid(fmt::format("cut feed: max_feed_mm_per_s = {} mm/s must be finite and >= min_feed_mm_per_s = {} mm/s",
+    return std::unexpected(invalid_argument(fmt::format("cut feed: max_feed_mm_per_s = {} mm/s must be finite and >= min_feed_mm_per_s = {} mm/s",
                                                params.max_feed_mm_per_s, params.min_feed_mm_per_s)));
   return {};
 }
@@ -94,7 +93,7 @@ std::expected<FeedModel, Error> parse_feed_model(std::string_view name) {
   for (FeedModel m : {FeedModel::limbachiya_patel, FeedModel::zeng_kim})
     if (name == feed_model_name(m)) return m;
   if (auto typed = feed_models().parse(name)) return *typed;
-  return std::unexpected(invalid(fmt::format("unknown feed model '{}' (known: limbachiya_patel, zeng_kim)", name)));
+  return std::unexpected(invalid_argument(fmt::format("unknown feed model '{}' (known: limbachiya_patel, zeng_kim)", name)));
 }
 
 double water_mass_flow_kg_per_s(const JetSetup& jet) {

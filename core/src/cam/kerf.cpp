@@ -15,22 +15,21 @@
 namespace lamina {
 namespace {
 
-Error bad(std::string message) { return Error{ErrorCode::invalid_argument, std::move(message)}; }
 
 bool positive(double v) { return std::isfinite(v) && v > 0.0; }
 
 std::expected<void, Error> check_cut(const KerfMeasurement& m, std::size_t row) {
   const std::string name = m.label.empty() ? fmt::format("row {}", row + 1) : fmt::format("cut '{}'", m.label);
-  if (!positive(m.path_mm)) return std::unexpected(bad(fmt::format("{}: path {} mm must be > 0", name, m.path_mm)));
+  if (!positive(m.path_mm)) return std::unexpected(invalid_argument(fmt::format("{}: path {} mm must be > 0", name, m.path_mm)));
   if (!positive(m.feed_ratio))
-    return std::unexpected(bad(fmt::format("{}: feed ratio {} must be > 0 (feed / separation feed)", name, m.feed_ratio)));
+    return std::unexpected(invalid_argument(fmt::format("{}: feed ratio {} must be > 0 (feed / separation feed)", name, m.feed_ratio)));
   const bool not_through = m.bottom_width_mm == 0.0;
   if (!positive(m.top_width_mm) || (!positive(m.bottom_width_mm) && !not_through))
-    return std::unexpected(bad(fmt::format("{}: widths {} / {} mm must be > 0 (top / bottom; a bottom of 0: not through)", name,
+    return std::unexpected(invalid_argument(fmt::format("{}: widths {} / {} mm must be > 0 (top / bottom; a bottom of 0: not through)", name,
                                            m.top_width_mm, m.bottom_width_mm)));
   if (not_through) return {};
   if (!positive(m.trail_back_mm))
-    return std::unexpected(bad(fmt::format("{}: trail-back {} mm must be > 0 (a real cut always lags; 0 is a missing reading)",
+    return std::unexpected(invalid_argument(fmt::format("{}: trail-back {} mm must be > 0 (a real cut always lags; 0 is a missing reading)",
                                            name, m.trail_back_mm)));
   return {};
 }
@@ -74,15 +73,15 @@ void add_residuals(KerfFit& fit, std::span<const KerfMeasurement> cuts) {
 }  // namespace
 
 std::expected<KerfShape, Error> kerf_at(const KerfModel& model, double path_mm, double feed_ratio) {
-  if (!positive(path_mm)) return std::unexpected(bad(fmt::format("kerf: path {} mm must be > 0", path_mm)));
+  if (!positive(path_mm)) return std::unexpected(invalid_argument(fmt::format("kerf: path {} mm must be > 0", path_mm)));
   if (!positive(feed_ratio))
-    return std::unexpected(bad(fmt::format("kerf: feed ratio {} must be > 0 (feed / separation feed)", feed_ratio)));
+    return std::unexpected(invalid_argument(fmt::format("kerf: feed ratio {} must be > 0 (feed / separation feed)", feed_ratio)));
   KerfShape k;
   k.top_width_mm = model.top_width_mm + model.top_width_per_ratio_mm * feed_ratio;
   const double taper_mm = path_mm * model.taper_per_ratio * (feed_ratio - model.taper_free_ratio);
   k.bottom_width_mm = k.top_width_mm - taper_mm;
   if (!(k.top_width_mm > 0.0) || !(k.bottom_width_mm > 0.0))
-    return std::unexpected(bad(fmt::format("kerf: at {:.3g} mm and feed ratio {:.3g} the model gives widths {:.3g} / {:.3g} mm "
+    return std::unexpected(invalid_argument(fmt::format("kerf: at {:.3g} mm and feed ratio {:.3g} the model gives widths {:.3g} / {:.3g} mm "
                                            "(top / bottom): beyond what it was calibrated for",
                                            path_mm, feed_ratio, k.top_width_mm, k.bottom_width_mm)));
   k.wall_lean_rad = std::atan2(taper_mm / 2.0, path_mm);
@@ -100,7 +99,7 @@ std::expected<KerfFit, Error> fit_kerf_model(std::span<const KerfMeasurement> cu
     through.push_back(&cuts[i]);
   }
   if (ratios.size() < 2)
-    return std::unexpected(bad(fmt::format("kerf fit: {} cut(s) through the sheet at {} feed ratio(s); it needs cuts at two "
+    return std::unexpected(invalid_argument(fmt::format("kerf fit: {} cut(s) through the sheet at {} feed ratio(s); it needs cuts at two "
                                            "speeds at least",
                                            through.size(), ratios.size())));
   const auto n = static_cast<Eigen::Index>(cuts.size()), nt = static_cast<Eigen::Index>(through.size());
@@ -117,14 +116,14 @@ std::expected<KerfFit, Error> fit_kerf_model(std::span<const KerfMeasurement> cu
     log_lag(i) = std::log(c.trail_back_mm / c.path_mm);
   }
   const auto width_line = line_fit(r, top), taper_line = line_fit(rt, taper), lag_line = line_fit(log_r, log_lag);
-  if (!width_line || !taper_line || !lag_line) return std::unexpected(bad("kerf fit: the feed ratios do not separate slope and intercept"));
+  if (!width_line || !taper_line || !lag_line) return std::unexpected(invalid_argument("kerf fit: the feed ratios do not separate slope and intercept"));
   KerfFit fit;
   fit.model.top_width_mm = width_line->first;
   fit.model.top_width_per_ratio_mm = width_line->second;
   fit.model.taper_per_ratio = taper_line->second;
   // Taper k·(r − r0) = a + k·r: r0 = −a / k. A taper that does not change with speed has no r0.
   if (std::abs(taper_line->second) < 1e-12)
-    return std::unexpected(bad("kerf fit: the taper does not change with the feed; the model's taper needs it to"));
+    return std::unexpected(invalid_argument("kerf fit: the taper does not change with the feed; the model's taper needs it to"));
   fit.model.taper_free_ratio = -taper_line->first / taper_line->second;
   fit.model.trail_back_factor = std::exp(lag_line->first);
   fit.model.trail_back_exponent = lag_line->second;

@@ -253,7 +253,7 @@ Paths minkowski_sum(const Path& a, const Path& b) {
 
 namespace {
 
-struct Window {
+struct BoxWindow {
   ClipperLib::cInt x0 = INT64_MAX, y0 = INT64_MAX, x1 = INT64_MIN, y1 = INT64_MIN;
   void add(const IntPoint& p) {
     x0 = std::min(x0, p.X);
@@ -261,18 +261,18 @@ struct Window {
     x1 = std::max(x1, p.X);
     y1 = std::max(y1, p.Y);
   }
-  bool meets(const Window& o) const { return x0 <= o.x1 && o.x0 <= x1 && y0 <= o.y1 && o.y0 <= y1; }
+  bool meets(const BoxWindow& o) const { return x0 <= o.x1 && o.x0 <= x1 && y0 <= o.y1 && o.y0 <= y1; }
 };
 
-Window window_of(const Path& ring) {
-  Window w;
+BoxWindow window_of(const Path& ring) {
+  BoxWindow w;
   for (const IntPoint& p : ring) w.add(p);
   return w;
 }
 
 // The pieces of G ⊕ (−C) (as minkowski_sum) that may meet `window`: the hull when both are
 // convex, else the edge-pair parallelograms whose bounds meet it, with G − c0 and −C + g0.
-void no_fit_pieces(const Path& g, const Path& neg, const Window& window, Paths& out) {
+void no_fit_pieces(const Path& g, const Path& neg, const BoxWindow& window, Paths& out) {
   if (is_convex(g) && is_convex(neg)) {
     for (Path& p : minkowski_sum(g, neg)) out.push_back(std::move(p));
     return;
@@ -299,7 +299,7 @@ void no_fit_pieces(const Path& g, const Path& neg, const Window& window, Paths& 
 
 Paths without_no_fit(const Paths& fit, const std::vector<Path>& children, const Path& c) {
   if (fit.empty() || children.empty()) return fit;
-  Window window;
+  BoxWindow window;
   for (const Path& p : fit)
     for (const IntPoint& q : p) window.add(q);
   // Only what meets the fit region's bounds can take anything from it: for a candidate that

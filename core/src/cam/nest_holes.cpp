@@ -31,7 +31,6 @@ using ClipperLib::IntPoint;
 using ClipperLib::Path;
 using ClipperLib::Paths;
 
-constexpr double kSlackMm = 1e-5;  // > the rounding of rotated points, proxies and region corners to nm
 // Where two region boundaries coincide (a candidate touching the hole's ring at a corner, say),
 // rounding the booleans to nm leaves needles ~1 nm wide whose corners are not feasible. The
 // feasible region is eroded by this much before its corners are used: no needle survives, and

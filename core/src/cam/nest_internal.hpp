@@ -11,6 +11,11 @@
 
 namespace lamina::cam_detail {
 
+// Spacing offsets and hole fits are made this much larger than asked, to cover libnest2d's 1 nm
+// truncation of rotated points and our rounding of proxies and region corners to nm: footprints
+// stay `spacing` apart and inside the margin.
+inline constexpr double kSlackMm = 1e-5;
+
 struct SheetSize {
   double length_mm = 0.0;  // x
   double width_mm = 0.0;   // y

@@ -42,10 +42,8 @@ namespace {
 namespace ln = libnest2d;
 
 // The half-spacing offset uses mitred joins (squared beyond Clipper's miter limit 2): every point
-// of the grown ring is at least the offset from the hull (round joins cut corners with chords).
-// It is made this much larger than half the spacing to cover libnest2d's 1 nm truncation of
-// rotated points and our rounding to nm, so footprints stay `spacing` apart and inside the margin.
-constexpr double kSlackMm = 1e-5;
+// of the grown ring is at least the offset from the hull (round joins cut corners with chords);
+// kSlackMm (nest_internal.hpp) more than half the spacing.
 
 using Path = ClipperLib::Path;
 using IntPoint = ClipperLib::IntPoint;

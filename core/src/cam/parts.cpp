@@ -87,7 +87,6 @@ bool inside(const ClipperLib::Paths& region, const Eigen::Vector2d& p) {
   return winding > 0;
 }
 
-Error invalid(std::string message) { return {ErrorCode::invalid_argument, std::move(message)}; }
 
 }  // namespace
 
@@ -96,12 +95,12 @@ std::string part_label(const Part& part) { return fmt::format("L{}-{}", part.lay
 std::expected<std::vector<Eigen::Vector2d>, Error> place_dowels(const BevelPlan& plan, const DowelParams& params) {
   if (params.count == 0) return std::vector<Eigen::Vector2d>{};
   if (params.count < 0 || params.count > 64)
-    return std::unexpected(invalid(fmt::format("dowels: count {} is outside 0 … 64", params.count)));
+    return std::unexpected(invalid_argument(fmt::format("dowels: count {} is outside 0 … 64", params.count)));
   if (!(params.diameter_mm > 0.0) || !std::isfinite(params.diameter_mm))
-    return std::unexpected(invalid(fmt::format("dowels: diameter {} mm must be > 0", params.diameter_mm)));
+    return std::unexpected(invalid_argument(fmt::format("dowels: diameter {} mm must be > 0", params.diameter_mm)));
   if (!(params.wall_mm >= 0.0) || !std::isfinite(params.wall_mm))
-    return std::unexpected(invalid(fmt::format("dowels: wall {} mm must be >= 0", params.wall_mm)));
-  if (plan.layers.empty()) return std::unexpected(invalid("dowels: the plan has no layers"));
+    return std::unexpected(invalid_argument(fmt::format("dowels: wall {} mm must be >= 0", params.wall_mm)));
+  if (plan.layers.empty()) return std::unexpected(invalid_argument("dowels: the plan has no layers"));
 
   // Where every layer has material, shrunk so a hole of the dowel's radius keeps its wall.
   ClipperLib::Paths common;
@@ -109,14 +108,14 @@ std::expected<std::vector<Eigen::Vector2d>, Error> place_dowels(const BevelPlan&
     const ClipperLib::Paths m = certain_material(plan.layers[i]);
     common = i == 0 ? m : boolean(ClipperLib::ctIntersection, common, m);
     if (common.empty())
-      return std::unexpected(invalid(fmt::format(
+      return std::unexpected(invalid_argument(fmt::format(
           "dowels: no area has material in every layer (layers 0 … {} share none)", plan.layers[i].index)));
   }
   const double r = 0.5 * params.diameter_mm;
   // 1 µm more: the offset rounds to Clipper's 1 nm grid, and the wall must hold, not nearly hold.
   const ClipperLib::Paths room = offset(common, -(r + params.wall_mm + 1e-3));
   if (room.empty())
-    return std::unexpected(invalid(fmt::format(
+    return std::unexpected(invalid_argument(fmt::format(
         "dowels: no room for a {} mm dowel with a {} mm wall where every layer has material", params.diameter_mm,
         params.wall_mm)));
 
@@ -155,7 +154,7 @@ std::expected<std::vector<Eigen::Vector2d>, Error> place_dowels(const BevelPlan&
       nearest[i] = chosen.size() == 1 ? (candidates[i] - p).norm() : std::min(nearest[i], (candidates[i] - p).norm());
   }
   if (static_cast<int>(chosen.size()) < params.count)
-    return std::unexpected(invalid(fmt::format(
+    return std::unexpected(invalid_argument(fmt::format(
         "dowels: only {} of {} dowels of {} mm fit {} mm apart where every layer has material", chosen.size(),
         params.count, params.diameter_mm, min_apart)));
   return chosen;
@@ -163,7 +162,7 @@ std::expected<std::vector<Eigen::Vector2d>, Error> place_dowels(const BevelPlan&
 
 std::expected<std::vector<Part>, Error> make_parts(const BevelPlan& plan, const PartParams& params) {
   if (!std::isfinite(params.kerf_mm) || params.kerf_mm < 0.0)
-    return std::unexpected(invalid(fmt::format("kerf {} mm must be finite and >= 0", params.kerf_mm)));
+    return std::unexpected(invalid_argument(fmt::format("kerf {} mm must be finite and >= 0", params.kerf_mm)));
   auto dowels = place_dowels(plan, params.dowels);
   if (!dowels) return std::unexpected(dowels.error());
 
@@ -176,10 +175,10 @@ std::expected<std::vector<Part>, Error> make_parts(const BevelPlan& plan, const 
       if (outer.is_hole) continue;
       for (const CutPass& pass : outer.passes)
         if (pass.lines.size() < 3)
-          return std::unexpected(invalid(fmt::format("layer {} outline {}: a pass with {} cut lines (needs 3 or more)",
+          return std::unexpected(invalid_argument(fmt::format("layer {} outline {}: a pass with {} cut lines (needs 3 or more)",
                                                      layer.index, oi, pass.lines.size())));
       if (outer.passes.empty())
-        return std::unexpected(invalid(fmt::format("layer {} outline {}: no cut passes", layer.index, oi)));
+        return std::unexpected(invalid_argument(fmt::format("layer {} outline {}: no cut passes", layer.index, oi)));
       Part part;
       part.layer_slot = static_cast<int>(slot);
       part.layer = layer.index;
@@ -197,7 +196,7 @@ std::expected<std::vector<Part>, Error> make_parts(const BevelPlan& plan, const 
       for (const auto& ring : reach)
         if (ClipperLib::Orientation(ring) && (!largest || ClipperLib::Area(ring) > ClipperLib::Area(*largest))) largest = &ring;
       if (!largest)
-        return std::unexpected(invalid(fmt::format("layer {} outline {}: the cuts enclose no area", layer.index, oi)));
+        return std::unexpected(invalid_argument(fmt::format("layer {} outline {}: the cuts enclose no area", layer.index, oi)));
       part.footprint_mm = geometry_detail::from_clipper(*largest);
 
       // Free room in each hole: inside every ring of the hole on both faces, less half the kerf.

@@ -43,36 +43,35 @@ using cam_detail::SheetFrame;
 // Lines of two passes at one station closer than this are the same cut.
 constexpr double kSameLineMm = 1e-6;
 
-Error invalid(std::string message) { return {ErrorCode::invalid_argument, std::move(message)}; }
 
 std::expected<void, Error> check_params(const ToolpathParams& p) {
   auto finite_at_least = [](double v, double lo) { return std::isfinite(v) && v >= lo; };
-  if (!finite_at_least(p.kerf_mm, 0.0)) return std::unexpected(invalid(fmt::format("kerf {} mm must be >= 0", p.kerf_mm)));
-  if (!finite_at_least(p.lead_in_mm, 0.0)) return std::unexpected(invalid(fmt::format("lead-in {} mm must be >= 0", p.lead_in_mm)));
-  if (!finite_at_least(p.lead_out_mm, 0.0)) return std::unexpected(invalid(fmt::format("lead-out {} mm must be >= 0", p.lead_out_mm)));
+  if (!finite_at_least(p.kerf_mm, 0.0)) return std::unexpected(invalid_argument(fmt::format("kerf {} mm must be >= 0", p.kerf_mm)));
+  if (!finite_at_least(p.lead_in_mm, 0.0)) return std::unexpected(invalid_argument(fmt::format("lead-in {} mm must be >= 0", p.lead_in_mm)));
+  if (!finite_at_least(p.lead_out_mm, 0.0)) return std::unexpected(invalid_argument(fmt::format("lead-out {} mm must be >= 0", p.lead_out_mm)));
   if (!finite_at_least(p.pierce_dwell_s, 0.0))
-    return std::unexpected(invalid(fmt::format("pierce dwell {} s must be >= 0", p.pierce_dwell_s)));
+    return std::unexpected(invalid_argument(fmt::format("pierce dwell {} s must be >= 0", p.pierce_dwell_s)));
   if (!(p.safe_z_mm > 0.0) || !std::isfinite(p.safe_z_mm))
-    return std::unexpected(invalid(fmt::format("safe height {} mm must be > 0", p.safe_z_mm)));
+    return std::unexpected(invalid_argument(fmt::format("safe height {} mm must be > 0", p.safe_z_mm)));
   if (!(p.rapid_mm_per_s > 0.0) || !std::isfinite(p.rapid_mm_per_s))
-    return std::unexpected(invalid(fmt::format("rapid rate {} mm/s must be > 0", p.rapid_mm_per_s)));
+    return std::unexpected(invalid_argument(fmt::format("rapid rate {} mm/s must be > 0", p.rapid_mm_per_s)));
   if (!(p.max_turn_per_move_rad > 0.0) || !std::isfinite(p.max_turn_per_move_rad))
-    return std::unexpected(invalid(fmt::format("largest turn per move {} rad must be > 0", p.max_turn_per_move_rad)));
+    return std::unexpected(invalid_argument(fmt::format("largest turn per move {} rad must be > 0", p.max_turn_per_move_rad)));
   if (p.microjoints < 0 || p.microjoints > 100)
-    return std::unexpected(invalid(fmt::format("microjoints {} must be 0 … 100", p.microjoints)));
+    return std::unexpected(invalid_argument(fmt::format("microjoints {} must be 0 … 100", p.microjoints)));
   if (!(p.microjoint_width_mm > 0.0) || !std::isfinite(p.microjoint_width_mm))
-    return std::unexpected(invalid(fmt::format("microjoint width {} mm must be > 0", p.microjoint_width_mm)));
+    return std::unexpected(invalid_argument(fmt::format("microjoint width {} mm must be > 0", p.microjoint_width_mm)));
   if (!(p.corner_min_fraction > 0.0 && p.corner_min_fraction <= 1.0))
-    return std::unexpected(invalid(fmt::format("corner slow-down fraction {} must be in (0, 1]", p.corner_min_fraction)));
+    return std::unexpected(invalid_argument(fmt::format("corner slow-down fraction {} must be in (0, 1]", p.corner_min_fraction)));
   const JetCorners& jc = p.jet_compensation.corners;
   if (!(std::isfinite(jc.error_mm) && jc.error_mm > 0.0))
-    return std::unexpected(invalid(fmt::format("corner error allowance {} mm must be > 0", jc.error_mm)));
+    return std::unexpected(invalid_argument(fmt::format("corner error allowance {} mm must be > 0", jc.error_mm)));
   if (!(jc.min_fraction > 0.0 && jc.min_fraction <= 1.0))
-    return std::unexpected(invalid(fmt::format("jet corner slow-down floor {} must be in (0, 1]", jc.min_fraction)));
+    return std::unexpected(invalid_argument(fmt::format("jet corner slow-down floor {} must be in (0, 1]", jc.min_fraction)));
   if (!(p.a_max_rad_per_s > 0.0) || !(p.c_max_rad_per_s > 0.0))
-    return std::unexpected(invalid(fmt::format("rotary rates A {} and C {} rad/s must be > 0", p.a_max_rad_per_s, p.c_max_rad_per_s)));
+    return std::unexpected(invalid_argument(fmt::format("rotary rates A {} and C {} rad/s must be > 0", p.a_max_rad_per_s, p.c_max_rad_per_s)));
   if (!finite_at_least(p.corner_angle_rad, 0.0))
-    return std::unexpected(invalid(fmt::format("corner angle {} rad must be >= 0", p.corner_angle_rad)));
+    return std::unexpected(invalid_argument(fmt::format("corner angle {} rad must be >= 0", p.corner_angle_rad)));
   return {};
 }
 
@@ -118,10 +117,10 @@ class SheetBuilder {
     std::vector<int> waiting(n, 0);  // children of each placement not cut yet
     for (const Placement& pl : sheet_.placements) {
       if (pl.part < 0 || static_cast<std::size_t>(pl.part) >= parts_.size())
-        return std::unexpected(invalid(fmt::format("sheet {}: a placement names part {} of {}", sheet_.index, pl.part,
+        return std::unexpected(invalid_argument(fmt::format("sheet {}: a placement names part {} of {}", sheet_.index, pl.part,
                                                    parts_.size())));
       if (pl.host >= static_cast<int>(n) || pl.host < -1 || pl.host == static_cast<int>(centre.size()))
-        return std::unexpected(invalid(fmt::format("sheet {}: placement {} names host {} of {}", sheet_.index,
+        return std::unexpected(invalid_argument(fmt::format("sheet {}: placement {} names host {} of {}", sheet_.index,
                                                    centre.size(), pl.host, n)));
       if (pl.host >= 0) ++waiting[static_cast<std::size_t>(pl.host)];
       const Part& part = parts_[static_cast<std::size_t>(pl.part)];
@@ -138,7 +137,7 @@ class SheetBuilder {
       for (std::size_t i = 0; i < n; ++i)
         if (!done[i] && waiting[i] == 0 && (best == n || (centre[i] - at).norm() < (centre[best] - at).norm())) best = i;
       if (best == n)
-        return std::unexpected(invalid(fmt::format("sheet {}: the placements' hosts form a cycle", sheet_.index)));
+        return std::unexpected(invalid_argument(fmt::format("sheet {}: the placements' hosts form a cycle", sheet_.index)));
       done[best] = true;
       order.push_back(static_cast<int>(best));
       if (const int h = sheet_.placements[best].host; h >= 0) --waiting[static_cast<std::size_t>(h)];
@@ -151,9 +150,9 @@ class SheetBuilder {
     const Placement& pl = sheet_.placements[static_cast<std::size_t>(placement_index)];  // checked by cutting_order
     const Part& part = parts_[static_cast<std::size_t>(pl.part)];
     if (part.layer_slot < 0 || static_cast<std::size_t>(part.layer_slot) >= plan_.layers.size())
-      return std::unexpected(invalid(fmt::format("part {}: layer slot {} is not in the plan", part_label(part), part.layer_slot)));
+      return std::unexpected(invalid_argument(fmt::format("part {}: layer slot {} is not in the plan", part_label(part), part.layer_slot)));
     if (std::abs(part.thickness_mm - sheet_.thickness_mm) > 1e-9)
-      return std::unexpected(invalid(fmt::format("part {} is {} mm thick, sheet {} is {} mm", part_label(part),
+      return std::unexpected(invalid_argument(fmt::format("part {} is {} mm thick, sheet {} is {} mm", part_label(part),
                                                  part.thickness_mm, sheet_.index, sheet_.thickness_mm)));
     const LayerPlan& layer = plan_.layers[static_cast<std::size_t>(part.layer_slot)];
     SheetFrame frame;
@@ -200,7 +199,7 @@ class SheetBuilder {
     const auto model = jc.kerf_by_material.find(material_.name);
     if (model == jc.kerf_by_material.end() && jc.mode == JetCompensationMode::automatic) return false;
     if (model == jc.kerf_by_material.end())
-      return std::unexpected(invalid(fmt::format("{}: no kerf calibration for '{}' (lamina calibrate coupon, then fit; docs/jet.md)",
+      return std::unexpected(invalid_argument(fmt::format("{}: no kerf calibration for '{}' (lamina calibrate coupon, then fit; docs/jet.md)",
                                                  where, material_.name)));
     std::vector<double> separation;
     for (const PathPoint& q : pts) {
@@ -292,13 +291,13 @@ class SheetBuilder {
                                           part_label(parts_[static_cast<std::size_t>(t.part)]), t.outline);
     if (outline.passes.empty() || outline.passes.back().lines.size() < 3 ||
         outline.stations.size() != outline.passes.back().lines.size())
-      return std::unexpected(invalid(where + ": no closed pass to cut"));
+      return std::unexpected(invalid_argument(where + ": no closed pass to cut"));
     const double h = 0.5 * p_.kerf_mm;
     const std::size_t last = outline.passes.size() - 1;
     std::vector<CompensatedPass> passes;
     for (const CutPass& pass : outline.passes) {
       if (pass.lines.size() != outline.stations.size())
-        return std::unexpected(invalid(where + ": passes with different station counts"));
+        return std::unexpected(invalid_argument(where + ": passes with different station counts"));
       passes.push_back(cam_detail::compensate_pass(outline, pass, frame, p_.part_on_right, h));
       if (auto ok = feed_points(passes.back().points, where); !ok) return ok;
       cam_detail::mark_corners(passes.back().points, p_.corner_angle_rad, p_.corner_min_fraction);
@@ -386,7 +385,7 @@ class SheetBuilder {
   std::expected<void, Error> cut_between(const CompensatedPass& pass, std::vector<double> gaps_u, double gap_mm,
                                          const Target& t, Frees frees) {
     if (gap_mm * static_cast<double>(gaps_u.size()) >= 0.9 * pass.length_mm)
-      return std::unexpected(invalid(fmt::format(
+      return std::unexpected(invalid_argument(fmt::format(
           "sheet {}, part {}: {} microjoint(s) of {} mm (kerf included) do not fit an outline {:.3f} mm long",
           sheet_.index, part_label(parts_[static_cast<std::size_t>(t.part)]), gaps_u.size(), gap_mm, pass.length_mm)));
     std::vector<double> centres;
@@ -414,7 +413,7 @@ class SheetBuilder {
     const double r = 0.5 * p_.dowel_diameter_mm;
     const double path_r = r - 0.5 * p_.kerf_mm;
     if (path_r <= 0.0)
-      return std::unexpected(invalid(fmt::format("dowel holes of {} mm are not wider than the kerf {} mm", 2 * r, p_.kerf_mm)));
+      return std::unexpected(invalid_argument(fmt::format("dowel holes of {} mm are not wider than the kerf {} mm", 2 * r, p_.kerf_mm)));
     const Eigen::Vector3d c = frame.point({centre_layer.x(), centre_layer.y(), frame.z_top_mm});
     const int n = std::max(24, static_cast<int>(std::ceil(2 * std::numbers::pi * path_r / 0.5)));
     std::vector<PathPoint> ring;

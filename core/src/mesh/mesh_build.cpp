@@ -371,11 +371,24 @@ std::expected<Mesh, Error> build_mesh(const TriangleSoup& soup, const MeshParams
 
   // Steps 9–10: summary and defects, one readable line each.
   summarize(m, adj, orient, surfaces, f);
+  m.summary.lowered_mm = zmin;
   add_repair_defects(m, f);
   add_topology_defects(m, orient, f);
   add_shell_defects(m);
   LAMINA_TICK("summary");
   return m;
+}
+
+Mesh in_frame_of(Mesh other, const Mesh& frame) {
+  const double dz = other.summary.lowered_mm - frame.summary.lowered_mm;
+  for (Eigen::Vector3d& v : other.vertices) v.z() += dz;
+  other.summary.bbox_min_mm.z() += dz;
+  other.summary.bbox_max_mm.z() += dz;
+  for (Defect& d : other.defects)
+    if (d.where) d.where->z() += dz;
+  for (BrepFace& f : other.brep_faces) f.origin.z() += dz;
+  other.summary.lowered_mm = frame.summary.lowered_mm;
+  return other;
 }
 
 }  // namespace lamina

@@ -1,5 +1,6 @@
 // The cut-program stage of a plan (issue 4): parts, nesting on the stock's sheets, one toolpath,
 // G-code program and SVG drawing per sheet.
+#include "lamina/core/elapsed.hpp"
 #include "lamina/core/plan_job.hpp"
 #include "lamina/core/sheet_svg.hpp"
 
@@ -11,7 +12,6 @@ namespace lamina {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 // The material a sheet is cut as when neither --material nor the stock names one.
 constexpr const char* kDefaultMaterial = "aluminium 6061-T6";

@@ -1,4 +1,5 @@
 // plan_job (plan_job.hpp): the stages of a plan put together once, for every front end.
+#include "lamina/core/elapsed.hpp"
 #include "lamina/core/plan_job.hpp"
 #include "lamina/core/stack_mesh.hpp"
 
@@ -13,7 +14,6 @@ namespace lamina {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 // At most this many layouts of the stack against the rack: each lowers a thickness's count.
 constexpr int kMaxRackRounds = 16;
@@ -179,7 +179,8 @@ std::expected<void, PlanJobError> measure_strategies(Run& run) {
       if (!p) return failed(PlanPhase::measuring_deviation, p.error());
       other = std::move(*p);
     }
-    auto d = measure_deviation(run.mesh, other ? *other : run.r.plan, deviation_params(settings));
+    const Mesh& reference = run.q.deviation_reference ? *run.q.deviation_reference : run.mesh;
+    auto d = measure_deviation(reference, other ? *other : run.r.plan, deviation_params(settings));
     if (!d) return failed(PlanPhase::measuring_deviation, d.error());
     run.r.deviations.push_back({s, *d});
     run.progress.step(PlanPhase::measuring_deviation, static_cast<int>(run.r.deviations.size()),

@@ -28,11 +28,25 @@ template <class S>
 struct Fields;
 
 template <>
+struct Fields<ReportCadSolid> {
+  static constexpr auto all = std::tuple{Field{"name", &ReportCadSolid::name}, Field{"faces", &ReportCadSolid::faces},
+                                         Field{"triangles", &ReportCadSolid::triangles}};
+};
+template <>
+struct Fields<ReportCad> {
+  static constexpr auto all =
+      std::tuple{Field{"length_unit", &ReportCad::length_unit}, Field{"chord_tolerance_mm", &ReportCad::chord_tolerance_mm},
+                 Field{"surface_normals", &ReportCad::surface_normals},
+                 Field{"deviation_chord_tolerance_mm", &ReportCad::deviation_chord_tolerance_mm}, Field{"solids", &ReportCad::solids},
+                 Field{"surface_kinds", &ReportCad::surface_kinds}};
+};
+template <>
 struct Fields<ReportModel> {
   static constexpr auto all = std::tuple{Field{"file", &ReportModel::file}, Field{"format", &ReportModel::format},
                                          Field{"triangles", &ReportModel::triangles},
                                          Field{"volume_mm3", &ReportModel::volume_mm3},
-                                         Field{"height_mm", &ReportModel::height_mm}};
+                                         Field{"height_mm", &ReportModel::height_mm}, Field{"cad", &ReportModel::cad}};
+  static constexpr bool omit_empty(std::string_view key) { return key == "cad"; }
 };
 template <>
 struct Fields<ReportStockSheet> {
@@ -398,6 +412,7 @@ struct Reader {
 }  // namespace
 
 std::string plan_report_json(const PlanReport& report) { return to_json(report).dump(2) + "\n"; }
+std::string report_cad_json(const ReportCad& cad) { return to_json(cad).dump(); }
 
 std::expected<PlanReport, Error> parse_plan_report(std::string_view text) {
   Json j;

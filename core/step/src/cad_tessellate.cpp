@@ -124,6 +124,7 @@ std::expected<TriangleSoup, Error> tessellate(const CadDocument& doc, const std:
   SoupBuilder b;
   b.soup.format = doc.format;
   b.brep.length_unit = doc.length_unit;
+  b.brep.chord_tolerance_mm = options.chord_tolerance_mm;
   IMeshTools_Parameters mesh;
   mesh.Deflection = options.chord_tolerance_mm;
   mesh.Angle = options.angle_tolerance_rad;

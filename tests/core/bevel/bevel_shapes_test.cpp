@@ -19,7 +19,7 @@ using test_shapes::RZ;
 using test_shapes::revolve;
 using bevel_test::uniform_layers;
 
-Mesh build(const TriangleSoup& soup) {
+Mesh usable_mesh(const TriangleSoup& soup) {
   auto m = build_mesh(soup, MeshParams{});
   EXPECT_TRUE(m.has_value());
   EXPECT_TRUE(m->usable());
@@ -38,7 +38,7 @@ double radial_component(const CutLine& l, const Eigen::Vector2d& at) {
 
 TEST(BevelShapes, ConeLeansTheToolInwardAtTheSurfaceAngle) {
   // Cone R 30 at the base, apex at z = 40: the surface is atan(30/40) from vertical.
-  const Mesh mesh = build(revolve({{0, 0}, {30, 0}, {0, 40}}, 96));
+  const Mesh mesh = usable_mesh(revolve({{0, 0}, {30, 0}, {0, 40}}, 96));
   const double slope_rad = std::atan2(30.0, 40.0);
   const auto p = plan(mesh, {{5.0, 10.0, 0, true}});
   ASSERT_EQ(p.layers.size(), 1u);
@@ -69,7 +69,7 @@ TEST(BevelShapes, ConeLeansTheToolInwardAtTheSurfaceAngle) {
 
 TEST(BevelShapes, OverhangLeansTheToolOutward) {
   // An inverted cone (narrow at the bottom): the flank overhangs, the nozzle leans out.
-  const Mesh mesh = build(revolve({{0, 0}, {10, 0}, {30, 20}, {0, 20}}, 96));
+  const Mesh mesh = usable_mesh(revolve({{0, 0}, {10, 0}, {30, 20}, {0, 20}}, 96));
   const auto p = plan(mesh, {{5.0, 10.0, 0, true}});
   const auto& outline = p.layers.at(0).outlines.at(0);
   for (std::size_t i = 0; i < outline.stations.size(); ++i) {
@@ -81,7 +81,7 @@ TEST(BevelShapes, OverhangLeansTheToolOutward) {
 
 TEST(BevelShapes, CountersunkHoleLeansAwayFromItsAxis) {
   // A disc R 30, 10 thick, with a bore widening from r 5 at the bottom to r 8 at the top.
-  const Mesh mesh = build(revolve({{5, 0}, {30, 0}, {30, 10}, {8, 10}}, 96));
+  const Mesh mesh = usable_mesh(revolve({{5, 0}, {30, 0}, {30, 10}, {8, 10}}, 96));
   const auto p = plan(mesh, {{0.0, 10.0, 0, true}});
   const auto& layer = p.layers.at(0);
   ASSERT_EQ(layer.outlines.size(), 2u);
@@ -110,7 +110,7 @@ TEST(BevelShapes, CountersunkHoleLeansAwayFromItsAxis) {
 }
 
 TEST(BevelShapes, SphereGetsTangentCutsWithinTheTiltLimitAndContinuousC) {
-  const Mesh mesh = build(mesh_test::uv_sphere(50.0, 128, 64, Eigen::Vector3d(0, 0, 50)));
+  const Mesh mesh = usable_mesh(mesh_test::uv_sphere(50.0, 128, 64, Eigen::Vector3d(0, 0, 50)));
   BevelParams params;
   const auto p = plan(mesh, uniform_layers(100.0, 10.0), params);
   ASSERT_EQ(p.layers.size(), 10u);
@@ -145,14 +145,14 @@ TEST(BevelShapes, SphereGetsTangentCutsWithinTheTiltLimitAndContinuousC) {
 }
 
 TEST(BevelShapes, VerticalStrategyAndBoxWalls) {
-  const Mesh box = build(mesh_test::box({0, 0, 0}, {40, 20, 12}));
+  const Mesh box = usable_mesh(mesh_test::box({0, 0, 0}, {40, 20, 12}));
   auto p = plan(box, uniform_layers(12.0, 4.0));
   for (const auto& layer : p.layers) {
     EXPECT_EQ(layer.passes, 1);
     EXPECT_LT(layer.max_deviation_mm, 1e-9);
     for (const auto& l : layer.outlines.at(0).passes.at(0).lines) EXPECT_NEAR(l.tilt_rad, 0.0, 1e-9);
   }
-  const Mesh sphere = build(mesh_test::uv_sphere(50.0, 64, 32, Eigen::Vector3d(0, 0, 50)));
+  const Mesh sphere = usable_mesh(mesh_test::uv_sphere(50.0, 64, 32, Eigen::Vector3d(0, 0, 50)));
   BevelParams params;
   params.fit.strategy = BevelStrategy::vertical;
   p = plan(sphere, uniform_layers(100.0, 10.0), params);
@@ -167,7 +167,7 @@ TEST(BevelShapes, VerticalStrategyAndBoxWalls) {
 }
 
 TEST(BevelShapes, SerialAndParallelPlansAgree) {
-  const Mesh mesh = build(mesh_test::uv_sphere(20.0, 48, 24, Eigen::Vector3d(0, 0, 20)));
+  const Mesh mesh = usable_mesh(mesh_test::uv_sphere(20.0, 48, 24, Eigen::Vector3d(0, 0, 20)));
   BevelParams a, b;
   b.parallel = false;
   const auto pa = plan(mesh, uniform_layers(40.0, 5.0), a);
@@ -186,7 +186,7 @@ TEST(BevelShapes, SerialAndParallelPlansAgree) {
 }
 
 TEST(BevelShapes, BadParametersAreRejected) {
-  const Mesh mesh = build(mesh_test::unit_cube());
+  const Mesh mesh = usable_mesh(mesh_test::unit_cube());
   BevelParams p;
   p.sub_slice_mm = 0;
   EXPECT_EQ(plan_bevels(mesh, uniform_layers(1, 0.5), p).error().code, ErrorCode::invalid_argument);

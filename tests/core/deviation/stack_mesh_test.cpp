@@ -25,7 +25,7 @@ using dev_test::make_layer;
 using dev_test::ngon_frustum_volume;
 using test::regular_polygon_area;
 
-BevelPlan plan_of(std::vector<LayerPlan> layers) {
+BevelPlan stack_plan_of(std::vector<LayerPlan> layers) {
   BevelPlan plan;
   plan.layers = std::move(layers);
   return plan;
@@ -84,7 +84,7 @@ TEST(StlWriter, HeaderAndLayout) {
 
 TEST(StackMesh, VerticalDiscIsItsPrism) {
   const int n = 90;
-  const BevelPlan plan = plan_of({disc_layer(0, 1.0, 3.0, 25.0, n)});
+  const BevelPlan plan = stack_plan_of({disc_layer(0, 1.0, 3.0, 25.0, n)});
   const Mesh mesh = reload(plan);
   EXPECT_EQ(mesh.summary.shells, 1);
   const double v = regular_polygon_area(n, 25.0) * 3.0;
@@ -96,7 +96,7 @@ TEST(StackMesh, SlopedLayersAndAHole) {
   const int n = 72;
   // Layer 0: a frustum 20 → 16 with a hole 6 → 8 (widening upwards); layer 1, 0.3 mm above, a
   // prism of radius 16 with a hole of radius 8.
-  const BevelPlan plan = plan_of({
+  const BevelPlan plan = stack_plan_of({
       make_layer(0, 0.0, 4.0,
                  {circle_outline(20.0, n, {{20.0, 16.0}}, 0.0, 4.0), circle_outline(6.0, n, {{6.0, 8.0}}, 0.0, 4.0, true, 0)},
                  {0.001, 1.0, 2.0, 3.0, 3.999}),
@@ -124,7 +124,7 @@ TEST(StackMesh, CurvedFormKinkIsARing) {
   // n-gon frusta.
   const int n = 64;
   const BevelPlan plan =
-      plan_of({make_layer(0, 0.0, 4.0, {circle_outline(20.0, n, {{20.0, 24.0}, {24.0, 20.0}}, 0.0, 4.0)}, {0.001, 3.999})});
+      stack_plan_of({make_layer(0, 0.0, 4.0, {circle_outline(20.0, n, {{20.0, 24.0}, {24.0, 20.0}}, 0.0, 4.0)}, {0.001, 3.999})});
   reload(plan);
   const double v = 2.0 * ngon_frustum_volume(n, 20.0, 22.0, 2.0);
   EXPECT_NEAR(volume(stack_mesh(plan)), v, 1e-6 * v);
@@ -138,7 +138,7 @@ TEST(StackMesh, AStraightCutWallIsOneRowAndAKinkedOneKeepsItsKink) {
   // One sloped cut (20 → 16) read from ten sub-slices: walls 2·n triangles, caps 2·(n − 2).
   std::vector<double> subs;
   for (int k = 0; k <= 10; ++k) subs.push_back(k == 0 ? 0.001 : k == 10 ? 4.999 : 0.5 * k);
-  const BevelPlan straight = plan_of({make_layer(0, 0.0, 5.0, {circle_outline(20.0, n, {{20.0, 16.0}}, 0.0, 5.0)}, subs)});
+  const BevelPlan straight = stack_plan_of({make_layer(0, 0.0, 5.0, {circle_outline(20.0, n, {{20.0, 16.0}}, 0.0, 5.0)}, subs)});
   reload(straight);
   EXPECT_EQ(stack_mesh(straight).triangle_count(), static_cast<std::size_t>(2 * n + 2 * (n - 2)));
   const double v = ngon_frustum_volume(n, 20.0, 16.0, 5.0);
@@ -146,7 +146,7 @@ TEST(StackMesh, AStraightCutWallIsOneRowAndAKinkedOneKeepsItsKink) {
 
   // Two crossing cuts (20 → 22 → 20): two rows of walls, the kink at mid-height kept.
   const BevelPlan kinked =
-      plan_of({make_layer(0, 0.0, 5.0, {circle_outline(20.0, n, {{20.0, 24.0}, {24.0, 20.0}}, 0.0, 5.0)}, subs)});
+      stack_plan_of({make_layer(0, 0.0, 5.0, {circle_outline(20.0, n, {{20.0, 24.0}, {24.0, 20.0}}, 0.0, 5.0)}, subs)});
   reload(kinked);
   EXPECT_EQ(stack_mesh(kinked).triangle_count(), static_cast<std::size_t>(4 * n + 2 * (n - 2)));
   const double vk = 2.0 * ngon_frustum_volume(n, 20.0, 22.0, 2.5);
@@ -156,7 +156,7 @@ TEST(StackMesh, AStraightCutWallIsOneRowAndAKinkedOneKeepsItsKink) {
 TEST(StackMesh, SeveralPartsInOneLayer) {
   const int n = 40;
   const Eigen::Vector2d a(-30, 0), b(30, 0);
-  const BevelPlan plan = plan_of({make_layer(
+  const BevelPlan plan = stack_plan_of({make_layer(
       0, 0.0, 2.0,
       {circle_outline(10.0, n, {{10.0, 9.0}}, 0.0, 2.0, false, -1, a), circle_outline(3.0, n, {{3.0, 3.0}}, 0.0, 2.0, true, 0, a),
        circle_outline(12.0, n, {{12.0, 12.0}}, 0.0, 2.0, false, -1, b),
@@ -175,7 +175,7 @@ TEST(StackMesh, CollapsingPinStaysClosed) {
   // cone (up to the collapse) and at most that plus a thin stub above.
   const int n = 48;
   const BevelPlan plan =
-      plan_of({make_layer(0, 0.0, 2.0, {circle_outline(3.0, n, {{3.0, -3.0}}, 0.0, 2.0)}, {0.001, 0.5, 1.0, 1.5, 1.999})});
+      stack_plan_of({make_layer(0, 0.0, 2.0, {circle_outline(3.0, n, {{3.0, -3.0}}, 0.0, 2.0)}, {0.001, 0.5, 1.0, 1.5, 1.999})});
   const Mesh mesh = reload(plan);
   EXPECT_EQ(mesh.summary.shells, 1);
   const double v = volume(stack_mesh(plan));
@@ -197,7 +197,7 @@ TEST(StackMesh, SwallowtailCornersStayClosed) {
       base.push_back(corners[side] + (corners[(side + 1) % 4] - corners[side]) * (k / 5.0));
       normals.push_back(side_normals[side]);
     }
-  const BevelPlan plan = plan_of({make_layer(
+  const BevelPlan plan = stack_plan_of({make_layer(
       0, 0.0, 1.0,
       {dev_test::make_outline(base, normals, 1, [&](int, std::size_t) { return dev_test::Offsets{-d, -d * 0.5}; }, 0.0, 1.0)})});
   const Mesh mesh = reload(plan);
@@ -230,7 +230,7 @@ TEST(StackMesh, CurvedFormSphereLayersAreClosedShells) {
     rho_max = std::max(rho_max, std::sqrt(std::max(0.0, R * R - std::pow(std::clamp(R, zc_lo, zc_hi) - R, 2.0))));
     layers.push_back(make_layer(i, zb, t, {circle_outline(rho_max, n, lines, zb, zt)}, subs));
   }
-  const BevelPlan plan = plan_of(layers);
+  const BevelPlan plan = stack_plan_of(layers);
   const Mesh mesh = reload(plan);
   EXPECT_EQ(mesh.summary.shells, static_cast<int>(layers.size()));
 

@@ -15,7 +15,7 @@ using test::binary_stl;
 using test::find_note;
 using test::StlFacet;
 
-const std::vector<StlFacet> kTwoFacets = {
+const std::vector<StlFacet> kTwoBinaryFacets = {
     {{0, 0, 1}, {1.5f, -2.25f, 3e-5f}, {100.125f, 0.0f, -7.0f}, {-0.0f, 1e20f, 42.0f}},
     {{1, 0, 0}, {4.0f, 5.0f, 6.0f}, {7.0f, 8.0f, 9.0f}, {-1.0f, -2.0f, -3.5f}},
 };
@@ -31,13 +31,13 @@ void expect_corners(const TriangleSoup& soup, const std::vector<StlFacet>& facet
 }
 
 TEST(StlBinary, ReadsExactCornersInFileOrder) {
-  const auto bytes = binary_stl(kTwoFacets);
+  const auto bytes = binary_stl(kTwoBinaryFacets);
   ASSERT_EQ(bytes.size(), 84u + 2 * 50u);
   auto soup = parse_stl(bytes, "two.stl");
   ASSERT_TRUE(soup) << soup.error().message;
   EXPECT_EQ(soup->format, "stl-binary");
   EXPECT_EQ(soup->triangle_count(), 2u);
-  expect_corners(*soup, kTwoFacets);
+  expect_corners(*soup, kTwoBinaryFacets);
   EXPECT_TRUE(soup->notes.empty()) << soup->notes.front().code;
 }
 
@@ -62,27 +62,27 @@ TEST(StlBinary, LittleEndianBytesDecodeToKnownFloats) {
 
 TEST(StlBinary, HeaderStartingWithSolidIsStillBinary) {
   for (std::string_view header : {"solid plate_holes", "solid", "SOLID name", "  solid x facet normal endsolid"}) {
-    const auto bytes = binary_stl(kTwoFacets, header);
+    const auto bytes = binary_stl(kTwoBinaryFacets, header);
     auto soup = parse_stl(bytes, "solid_header.stl");
     ASSERT_TRUE(soup) << header << ": " << soup.error().message;
     EXPECT_EQ(soup->format, "stl-binary") << header;
-    expect_corners(*soup, kTwoFacets);
+    expect_corners(*soup, kTwoBinaryFacets);
   }
 }
 
 TEST(StlBinary, TrailingBytesAreNotedWithTheirCount) {
   {
-    auto soup = parse_stl(binary_stl(kTwoFacets, "solid test.stl", 1), "one_extra.stl");
+    auto soup = parse_stl(binary_stl(kTwoBinaryFacets, "solid test.stl", 1), "one_extra.stl");
     ASSERT_TRUE(soup) << soup.error().message;
     EXPECT_EQ(soup->format, "stl-binary");
-    expect_corners(*soup, kTwoFacets);
+    expect_corners(*soup, kTwoBinaryFacets);
     const ReadNote* note = find_note(*soup, "trailing_bytes");
     ASSERT_NE(note, nullptr);
     EXPECT_NE(note->message.find("1 trailing byte "), std::string::npos) << note->message;
     EXPECT_NE(note->message.find("one_extra.stl"), std::string::npos) << note->message;
   }
   {
-    auto soup = parse_stl(binary_stl(kTwoFacets, "x", 49), "many_extra.stl");
+    auto soup = parse_stl(binary_stl(kTwoBinaryFacets, "x", 49), "many_extra.stl");
     ASSERT_TRUE(soup) << soup.error().message;
     EXPECT_EQ(soup->triangle_count(), 2u);
     const ReadNote* note = find_note(*soup, "trailing_bytes");
@@ -93,7 +93,7 @@ TEST(StlBinary, TrailingBytesAreNotedWithTheirCount) {
 
 TEST(StlBinary, ShorterThanDeclaredIsTruncatedWithCounts) {
   // Declares 5 triangles, holds 2 complete ones and 30 bytes of a third.
-  auto bytes = binary_stl(kTwoFacets, "cut", 30, 5);
+  auto bytes = binary_stl(kTwoBinaryFacets, "cut", 30, 5);
   ASSERT_EQ(bytes.size(), 84u + 100u + 30u);
   auto soup = parse_stl(bytes, "cut.stl");
   ASSERT_FALSE(soup);
@@ -104,7 +104,7 @@ TEST(StlBinary, ShorterThanDeclaredIsTruncatedWithCounts) {
   EXPECT_NE(m.find("2 complete triangles"), std::string::npos) << m;
 
   // Same with a "solid" header: the size, not the first word, decides.
-  auto solid = parse_stl(binary_stl(kTwoFacets, "solid cut", 0, 3), "solid_cut.stl");
+  auto solid = parse_stl(binary_stl(kTwoBinaryFacets, "solid cut", 0, 3), "solid_cut.stl");
   ASSERT_FALSE(solid);
   EXPECT_EQ(solid.error().code, ErrorCode::truncated_file) << solid.error().message;
   EXPECT_NE(solid.error().message.find("declares 3 triangles"), std::string::npos) << solid.error().message;
@@ -115,7 +115,7 @@ TEST(StlBinary, TooShortOrEmptyIsAnError) {
   ASSERT_FALSE(empty);
   EXPECT_EQ(empty.error().code, ErrorCode::empty_mesh);
 
-  const auto full = binary_stl(kTwoFacets, "");
+  const auto full = binary_stl(kTwoBinaryFacets, "");
   for (std::size_t n : {1u, 10u, 80u, 83u}) {
     auto r = parse_stl(std::span(full).first(n), "short.stl");
     ASSERT_FALSE(r) << n;
@@ -131,7 +131,7 @@ TEST(StlBinary, ZeroDeclaredTrianglesIsEmpty) {
 }
 
 TEST(StlBinary, AllZeroStoredNormalsAreNoted) {
-  std::vector<StlFacet> facets = kTwoFacets;
+  std::vector<StlFacet> facets = kTwoBinaryFacets;
   for (auto& f : facets) f.normal = {0, 0, 0};
   auto soup = parse_stl(binary_stl(facets), "zero_normals.stl");
   ASSERT_TRUE(soup) << soup.error().message;
@@ -141,7 +141,7 @@ TEST(StlBinary, AllZeroStoredNormalsAreNoted) {
 }
 
 TEST(StlBinary, NonUnitStoredNormalsAreNoted) {
-  std::vector<StlFacet> facets = kTwoFacets;
+  std::vector<StlFacet> facets = kTwoBinaryFacets;
   facets[1].normal = {0.0f, 1.35f, 0.0f};
   auto soup = parse_stl(binary_stl(facets), "long_normal.stl");
   ASSERT_TRUE(soup) << soup.error().message;
@@ -161,7 +161,7 @@ TEST(StlBinary, NonUnitStoredNormalsAreNoted) {
 TEST(StlBinary, NanAndInfCoordinatesAreKeptAndNoted) {
   const float nan = std::numeric_limits<float>::quiet_NaN();
   const float inf = std::numeric_limits<float>::infinity();
-  std::vector<StlFacet> facets = kTwoFacets;
+  std::vector<StlFacet> facets = kTwoBinaryFacets;
   facets[0].b = {nan, 1.0f, 2.0f};
   facets[1].c = {3.0f, -inf, nan};
   auto soup = parse_stl(binary_stl(facets), "nan.stl");

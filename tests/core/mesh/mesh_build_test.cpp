@@ -220,5 +220,26 @@ TEST(BuildMesh, SeverityNames) {
   EXPECT_STREQ(severity_name(Severity::error), "error");
 }
 
+// Two tessellations of one model (a B-rep planned at one chord, measured against a finer one)
+// share a frame: each is lowered by its own lowest vertex, so the finer one is moved by the
+// difference. A cylinder on its side: 7 segments reach down to 0.901 r, 6 to r; both have their
+// highest vertex at x = r.
+TEST(MeshFrame, AnotherTessellationLandsInTheFirstsFrame) {
+  MeshParams p;
+  p.axis = BuildAxis::x;
+  auto coarse = build_mesh(mesh_test::cylinder(10, 30, 7), p);
+  auto fine = build_mesh(mesh_test::cylinder(10, 30, 6), p);
+  ASSERT_TRUE(coarse && fine);
+  EXPECT_NEAR(fine->summary.lowered_mm - coarse->summary.lowered_mm, -10 * (1 - std::cos(std::numbers::pi / 7)), 1e-5);
+  const Mesh moved = in_frame_of(*fine, *coarse);
+  EXPECT_NEAR(moved.summary.bbox_max_mm.z(), coarse->summary.bbox_max_mm.z(), 1e-5) << "the shared top vertex";
+  double lowest = 0, highest = 0;
+  for (const Eigen::Vector3d& v : moved.vertices) lowest = std::min(lowest, v.z()), highest = std::max(highest, v.z());
+  EXPECT_NEAR(highest, coarse->summary.bbox_max_mm.z(), 1e-5);
+  EXPECT_NEAR(lowest, moved.summary.bbox_min_mm.z(), 1e-12);
+  EXPECT_LT(lowest, -0.9) << "the finer one reaches below the frame's zero";
+  EXPECT_EQ(moved.summary.lowered_mm, coarse->summary.lowered_mm);
+}
+
 }  // namespace
 }  // namespace lamina

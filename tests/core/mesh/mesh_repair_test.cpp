@@ -21,7 +21,7 @@ using mesh_test::structure_problem;
 using mesh_test::unit_cube;
 
 
-std::size_t defect_count(const Mesh& m, std::string_view code) {
+std::size_t repair_defect_count(const Mesh& m, std::string_view code) {
   const Defect* d = m.find_defect(code);
   return d ? d->count : 0;
 }
@@ -76,7 +76,7 @@ TEST(MeshRepair, ToleranceComesFromTheWholeModelNotASample) {
   EXPECT_EQ(m.summary.boundary_edges, 3u);  // only the lone triangle's
   EXPECT_EQ(m.summary.shells, 2);
   EXPECT_TRUE(m.shell_info[0].closed);
-  EXPECT_GT(defect_count(m, "welded_vertices"), 0u);
+  EXPECT_GT(repair_defect_count(m, "welded_vertices"), 0u);
   EXPECT_EQ(m.summary.vertices, 2u + 128u * 39 + 3);
 }
 
@@ -122,7 +122,7 @@ TEST(MeshRepair, MinorityOfFacetsIsFlipped) {
   TriangleSoup s = unit_cube();
   for (std::size_t f : {0u, 1u, 2u, 3u, 4u, 5u, 6u, 7u}) mesh_test::flip_facet(s, f);  // 8 of 12
   const Mesh m = build_checked(s);
-  EXPECT_EQ(defect_count(m, "inconsistent_winding"), 4u);
+  EXPECT_EQ(repair_defect_count(m, "inconsistent_winding"), 4u);
   EXPECT_NEAR(m.summary.volume_mm3, 1.0, 1e-12);
 }
 
@@ -162,14 +162,14 @@ TEST(MeshRepair, CubeWithCavityKeepsTheCavityNegative) {
 
 TEST(MeshRepair, CavityWoundOutwardIsTurnedInward) {
   const Mesh m = build_checked(append(box({0, 0, 0}, {3, 3, 3}), box({1, 1, 1}, {2, 2, 2})));
-  EXPECT_EQ(defect_count(m, "inside_out"), 1u);
+  EXPECT_EQ(repair_defect_count(m, "inside_out"), 1u);
   EXPECT_NEAR(m.summary.volume_mm3, 26.0, 1e-12);
   EXPECT_NEAR(m.shell_info[1].volume_mm3, -1.0, 1e-12);
 }
 
 TEST(MeshRepair, EverythingInvertedIsTurnedBack) {
   const Mesh m = build_checked(inverted(append(box({0, 0, 0}, {3, 3, 3}), inverted(box({1, 1, 1}, {2, 2, 2})))));
-  EXPECT_EQ(defect_count(m, "inside_out"), 2u);
+  EXPECT_EQ(repair_defect_count(m, "inside_out"), 2u);
   EXPECT_NEAR(m.summary.volume_mm3, 26.0, 1e-12);
 }
 
@@ -184,7 +184,7 @@ TEST(MeshRepair, IslandInsideACavityIsASolidAgain) {
   EXPECT_EQ(m.shell_info[2].depth, 2);
   EXPECT_NEAR(m.shell_info[2].volume_mm3, 1.0, 1e-12);
   EXPECT_NEAR(m.summary.volume_mm3, 125.0 - 27.0 + 1.0, 1e-12);
-  EXPECT_EQ(defect_count(m, "inside_out"), 1u);
+  EXPECT_EQ(repair_defect_count(m, "inside_out"), 1u);
 }
 
 TEST(MeshRepair, ManyVoidsInABlockAreAllCavities) {
@@ -199,7 +199,7 @@ TEST(MeshRepair, ManyVoidsInABlockAreAllCavities) {
       }
   const Mesh m = build_checked(s);
   ASSERT_EQ(m.summary.shells, 401);
-  EXPECT_EQ(defect_count(m, "inside_out"), 400u);
+  EXPECT_EQ(repair_defect_count(m, "inside_out"), 400u);
   EXPECT_NEAR(m.summary.volume_mm3, 8000.0 - 400 * 0.125, 1e-6);
   for (int sh = 1; sh < 401; ++sh) {
     EXPECT_EQ(m.shell_info[static_cast<std::size_t>(sh)].depth, 1);
@@ -215,7 +215,7 @@ TEST(MeshRepair, SphericalCavityInASphere) {
   const Mesh m = build_checked(append(outer, inner));
   ASSERT_EQ(m.summary.shells, 2);
   EXPECT_EQ(m.shell_info[1].depth, 1);
-  EXPECT_EQ(defect_count(m, "inside_out"), 1u);
+  EXPECT_EQ(repair_defect_count(m, "inside_out"), 1u);
   EXPECT_NEAR(m.summary.volume_mm3, mesh_test::soup_volume(outer) - mesh_test::soup_volume(inner), 1e-6);
 }
 
@@ -231,8 +231,8 @@ TEST(MeshRepair, OverlappingSolidsAreNotCavities) {
 TEST(MeshRepair, TwoDisjointCubes) {
   const Mesh m = build_checked(append(unit_cube(), inverted(box({3, 0, 0}, {4, 1, 1}))));
   EXPECT_EQ(m.summary.shells, 2);
-  EXPECT_EQ(defect_count(m, "multiple_shells"), 2u);
-  EXPECT_EQ(defect_count(m, "inside_out"), 1u);
+  EXPECT_EQ(repair_defect_count(m, "multiple_shells"), 2u);
+  EXPECT_EQ(repair_defect_count(m, "inside_out"), 1u);
   EXPECT_NEAR(m.summary.volume_mm3, 2.0, 1e-12);
   EXPECT_TRUE(m.summary.watertight);
   EXPECT_TRUE(m.usable());
@@ -273,7 +273,7 @@ TEST(MeshRepair, CubesSharingAnEdgeAreNonManifoldAndTwoShells) {
   EXPECT_EQ(m.summary.shells, 2);  // the non-manifold edge does not join them
   EXPECT_TRUE(m.shell_info[0].closed);
   EXPECT_TRUE(m.shell_info[1].closed);
-  EXPECT_EQ(defect_count(m, "inside_out"), 1u);
+  EXPECT_EQ(repair_defect_count(m, "inside_out"), 1u);
   EXPECT_EQ(m.find_defect("inconsistent_winding"), nullptr);
   EXPECT_NEAR(m.summary.volume_mm3, 2.0, 1e-12);
   EXPECT_FALSE(m.summary.watertight);
@@ -309,7 +309,7 @@ TEST(MeshRepair, FacetCollapsedByTheWeldIsDegenerate) {
   TriangleSoup s = unit_cube();
   mesh_test::add_tri(s, {0, 0, 0}, {1e-9f, 0, 0}, {1, 1, 1});  // two corners weld into one
   const Mesh m = build_checked(s);
-  EXPECT_EQ(defect_count(m, "degenerate_facets"), 1u);
+  EXPECT_EQ(repair_defect_count(m, "degenerate_facets"), 1u);
   EXPECT_EQ(m.summary.triangles, 12u);
 }
 

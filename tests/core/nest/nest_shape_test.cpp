@@ -14,7 +14,7 @@ namespace {
 
 using namespace nest_test;
 
-NestParams with(NestMethod m, double spacing = 6.0, double margin = 10.0) {
+NestParams shape_params(NestMethod m, double spacing = 6.0, double margin = 10.0) {
   NestParams p;
   p.method = m;
   p.spacing_mm = spacing;
@@ -34,7 +34,7 @@ TEST(NestShape, PlacementReproducesLibnest2dTransform) {
   }
   std::vector<int> unplaced;
   cam_detail::ShapePackDiagnostics diag;
-  const auto sheets = cam_detail::pack_shape(parts, which, {400, 300}, with(NestMethod::shape), unplaced, &diag);
+  const auto sheets = cam_detail::pack_shape(parts, which, {400, 300}, shape_params(NestMethod::shape), unplaced, &diag);
   EXPECT_TRUE(unplaced.empty());
   EXPECT_EQ(diag.items, 12);
   EXPECT_LT(diag.max_transform_error_mm, 2e-6);
@@ -55,9 +55,9 @@ TEST(NestShape, AllInvariantsOnMixedPartsForBothMethods) {
     parts.push_back(make_part(circle(60, 64, 400, 400), 1.0, 4, island++, std::numbers::pi * 30 * 30));
   const Stock stock = one_sheet_kind(1.0, 600, 400);
   for (NestMethod m : {NestMethod::matrix, NestMethod::shape}) {
-    auto nest = nest_parts(parts, stock, with(m));
+    auto nest = nest_parts(parts, stock, shape_params(m));
     ASSERT_TRUE(nest) << nest.error().message;
-    const Summary s = check_nest(parts, stock, with(m), *nest);
+    const Summary s = check_nest(parts, stock, shape_params(m), *nest);
     std::printf("[%s] %zu mixed parts on 600 x 400: %d sheets, mean utilisation %.3f\n", nest_method_name(m),
                 parts.size(), s.sheets, s.mean_utilisation);
   }
@@ -79,9 +79,9 @@ TEST(NestShape, NoMoreSheetsThanMatrixOnTrianglesAndLShapes) {
   for (const Case& c : cases) {
     Summary got[2];
     for (NestMethod m : {NestMethod::matrix, NestMethod::shape}) {
-      auto nest = nest_parts(c.parts, stock, with(m));
+      auto nest = nest_parts(c.parts, stock, shape_params(m));
       ASSERT_TRUE(nest) << nest.error().message;
-      got[static_cast<int>(m)] = check_nest(c.parts, stock, with(m), *nest);
+      got[static_cast<int>(m)] = check_nest(c.parts, stock, shape_params(m), *nest);
       std::printf("[%s] %zu %s on 1000 x 500: %d sheets, mean utilisation %.3f\n", nest_method_name(m),
                   c.parts.size(), c.name, got[static_cast<int>(m)].sheets,
                   got[static_cast<int>(m)].mean_utilisation);
@@ -98,7 +98,7 @@ TEST(NestShape, SameResultWithAndWithoutThreads) {
   Stock stock;
   stock.sheets.push_back({1.0, 300, 500, 0, "", ""});
   stock.sheets.push_back({2.0, 300, 500, 0, "", ""});
-  NestParams a = with(NestMethod::shape);
+  NestParams a = shape_params(NestMethod::shape);
   a.parallel = true;
   NestParams b = a;
   b.parallel = false;
@@ -124,9 +124,9 @@ TEST(NestShape, ZeroSpacingAndMargin) {
   for (int i = 0; i < 8; ++i) parts.push_back(make_part(rect(50, 50), 1.0, 1, i + 1));
   const Stock stock = one_sheet_kind(1.0, 200, 100);
   for (NestMethod m : {NestMethod::matrix, NestMethod::shape}) {
-    auto nest = nest_parts(parts, stock, with(m, 0.0, 0.0));
+    auto nest = nest_parts(parts, stock, shape_params(m, 0.0, 0.0));
     ASSERT_TRUE(nest) << nest.error().message;
-    check_nest(parts, stock, with(m, 0.0, 0.0), *nest);
+    check_nest(parts, stock, shape_params(m, 0.0, 0.0), *nest);
   }
 }
 

@@ -112,6 +112,22 @@ TEST(PlanJob, TheAsCutFiguresReadBackAndAreLeftOutWithoutThem) {
   EXPECT_EQ(back->as_cut->layers.at(0).as_cut.max_at_mm[2], 6.0);
 }
 
+// A STEP model's plan says what the file told it (model.cad: unit, chord, normals, solids, surface
+// kinds); it reads back, and a mesh's report leaves the key out.
+TEST(PlanJob, TheCadFiguresReadBackAndAreLeftOutForAMesh) {
+  PlanReport report = planned().report;
+  EXPECT_EQ(plan_report_json(report).find("\"cad\""), std::string::npos);
+  report.model.cad = ReportCad{"INCH", 0.005, "exact", 0.0005, {{"fork", 118, 4000}, {"pin", 3, 96}}, {{"plane", 40}, {"torus", 81}}};
+  const std::string text = plan_report_json(report);
+  auto back = parse_plan_report(text);
+  ASSERT_TRUE(back) << back.error().message;
+  EXPECT_EQ(plan_report_json(*back), text);
+  ASSERT_TRUE(back->model.cad);
+  EXPECT_EQ(back->model.cad->solids.at(1).name, "pin");
+  EXPECT_EQ(back->model.cad->surface_kinds.at(1), (std::pair<std::string, std::int64_t>{"torus", 81}));
+  EXPECT_EQ(nlohmann::json::parse(report_cad_json(*report.model.cad)), nlohmann::json::parse(text)["model"]["cad"]);
+}
+
 // A reader of the programs (the web console's 3D toolpath) needs the head to turn X Y Z A C into
 // the tool tip and axis, and the operator the rack slot each sheet is taken from.
 TEST(PlanJob, TheReportCarriesTheHeadAndEachSheetsRackSlot) {

@@ -17,7 +17,7 @@ using lamina::HeadKinematics;
 using lamina::PostDialect;
 using lamina::PostParams;
 
-constexpr double deg = std::numbers::pi / 180.0;
+constexpr double kRadPerDeg = std::numbers::pi / 180.0;
 
 std::vector<std::string> lines_of(const std::string& text) {
   std::vector<std::string> out;
@@ -37,7 +37,7 @@ lamina::PostedProgram post(PostDialect d, bool rtcp, const std::string& title = 
   // Values that print as -0, whole numbers and trailing zeros: a vertical square at the origin.
   auto posted = lamina::post_program(
       post_test::make_toolpath({post_test::vertical_rectangle({-0.0001, 0}, 10, 2.5, 2),
-                                post_test::cone({50, 50}, 10, 30 * deg, 1.0, 12)}),
+                                post_test::cone({50, 50}, 10, 30 * kRadPerDeg, 1.0, 12)}),
       head, params);
   EXPECT_TRUE(posted) << (posted ? "" : posted.error().message);
   return posted ? *posted : lamina::PostedProgram{};

@@ -31,15 +31,15 @@ std::vector<post_test::ContourSpec> typical_sheet() {
   return specs;
 }
 
-struct Case {
+struct RoundTripCase {
   PostDialect dialect;
   bool rtcp;
 };
 
-class PostRoundTrip : public ::testing::TestWithParam<Case> {};
+class PostRoundTrip : public ::testing::TestWithParam<RoundTripCase> {};
 
 TEST_P(PostRoundTrip, EveryMoveEndIsThePlannedTipAndAxis) {
-  const Case c = GetParam();
+  const RoundTripCase c = GetParam();
   HeadKinematics head;
   head.rtcp = c.rtcp;
   PostParams params;
@@ -71,9 +71,9 @@ TEST_P(PostRoundTrip, EveryMoveEndIsThePlannedTipAndAxis) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Dialects, PostRoundTrip,
-                         ::testing::Values(Case{PostDialect::grblhal, false}, Case{PostDialect::fanuc, false},
-                                           Case{PostDialect::fanuc, true}, Case{PostDialect::linuxcnc, false},
-                                           Case{PostDialect::linuxcnc, true}),
+                         ::testing::Values(RoundTripCase{PostDialect::grblhal, false}, RoundTripCase{PostDialect::fanuc, false},
+                                           RoundTripCase{PostDialect::fanuc, true}, RoundTripCase{PostDialect::linuxcnc, false},
+                                           RoundTripCase{PostDialect::linuxcnc, true}),
                          [](const auto& info) {
                            return std::string(lamina::post_dialect_name(info.param.dialect)) +
                                   (info.param.rtcp ? "_rtcp" : "_pivot");

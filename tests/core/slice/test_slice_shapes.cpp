@@ -16,7 +16,7 @@ namespace {
 
 constexpr double kRel = 5e-4;  // 0.05 %
 
-std::vector<Slice> cut(const Mesh& mesh, const std::vector<double>& zs) {
+std::vector<Slice> slice_at(const Mesh& mesh, const std::vector<double>& zs) {
   auto s = slice_mesh(mesh, zs, SliceParams{});
   EXPECT_TRUE(s.has_value());
   return s ? std::move(*s) : std::vector<Slice>{};
@@ -35,7 +35,7 @@ TEST(SliceShapes, SphereSectionsMatchTheFacetedSolid) {
   const Mesh mesh = mesh_test::build_checked(test::uv_sphere(r, seg, rings));
   std::mt19937 rng(7);
   const auto zs = random_heights(rng, 0.01, 2 * r - 0.01, 40);
-  const auto slices = cut(mesh, zs);
+  const auto slices = slice_at(mesh, zs);
   for (std::size_t i = 0; i < zs.size(); ++i) {
     const double expected = test::uv_sphere_section_area(r, seg, rings, zs[i] - r);
     ASSERT_EQ(slices[i].loops.size(), 1u) << "z=" << zs[i];
@@ -50,7 +50,7 @@ TEST(SliceShapes, TubeHasOneOuterAndOneNestedHole) {
   const Mesh mesh = mesh_test::build_checked(test::tube(R, r, h, seg));
   std::mt19937 rng(11);
   const auto zs = random_heights(rng, 0.1, h - 0.1, 20);
-  const auto slices = cut(mesh, zs);
+  const auto slices = slice_at(mesh, zs);
   for (std::size_t i = 0; i < zs.size(); ++i) {
     const Slice& s = slices[i];
     ASSERT_EQ(s.loops.size(), 2u);
@@ -79,7 +79,7 @@ TEST(SliceShapes, TorusSectionsMatchTheFacetedSolid) {
   const double zmin = test::torus_z_min(r, minr), zmax = test::torus_z_max(r, minr);
   std::mt19937 rng(13);
   const auto zs = random_heights(rng, 0.05, zmax - zmin - 0.05, 30);
-  const auto slices = cut(mesh, zs);
+  const auto slices = slice_at(mesh, zs);
   for (std::size_t i = 0; i < zs.size(); ++i) {
     const double expected = test::torus_section_area(R, r, maj, minr, zs[i] + zmin);
     EXPECT_EQ(slices[i].outer_count(), 1);
@@ -99,7 +99,7 @@ TEST(SliceShapes, AreasAreInvariantUnderRandomRotations) {
     const Mesh reference = mesh_test::build_checked(*shape);
     const double h = reference.summary.bbox_max_mm.z();
     const std::vector<double> zs{0.13 * h, 0.37 * h, 0.5 * h, 0.71 * h, 0.93 * h};
-    const auto want = cut(reference, zs);
+    const auto want = slice_at(reference, zs);
     for (int trial = 0; trial < 8; ++trial) {
       const Eigen::Quaterniond q = Eigen::Quaterniond(g(rng), g(rng), g(rng), g(rng)).normalized();
       TriangleSoup rotated = *shape;
@@ -109,7 +109,7 @@ TEST(SliceShapes, AreasAreInvariantUnderRandomRotations) {
       p.direction = q * Eigen::Vector3d::UnitZ();
       const Mesh mesh = mesh_test::build_checked(rotated, p);
       EXPECT_NEAR(mesh.summary.bbox_max_mm.z(), h, 1e-4 * h);
-      const auto got = cut(mesh, zs);
+      const auto got = slice_at(mesh, zs);
       for (std::size_t i = 0; i < zs.size(); ++i) {
         SCOPED_TRACE(::testing::Message() << "trial " << trial << " z=" << zs[i]);
         EXPECT_EQ(got[i].outer_count(), want[i].outer_count());

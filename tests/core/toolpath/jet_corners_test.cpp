@@ -14,27 +14,27 @@ namespace lamina {
 namespace {
 
 // Trail-back 0.8 · h_f · r²: at this sheet and feed a lag the corners must slow for.
-const KerfModel kKerf{.top_width_mm = 1.0,
+const KerfModel kCornerKerf{.top_width_mm = 1.0,
                       .top_width_per_ratio_mm = 0.0,
                       .taper_per_ratio = 0.05,
                       .taper_free_ratio = 0.1,
                       .trail_back_factor = 0.8,
                       .trail_back_exponent = 2.0};
-constexpr double kHalfSide = 20.0, kHoleHalf = 8.0, kThickness = 5.0, kKerfMm = 1.0;
-const Eigen::Vector2d kCentre(100, 50);
+constexpr double kCornerHalfSide = 20.0, kHoleHalf = 8.0, kCornerThickness = 5.0, kCornerKerfMm = 1.0;
+const Eigen::Vector2d kCornerCentre(100, 50);
 
 // A 40 mm square of 5 mm plate, vertical walls, with (or without) a 16 mm square hole.
 Fixture part(bool with_hole) {
-  std::vector<LayerOutline> outlines{dev_test::square_outline({0, 0}, kHalfSide, 0, kThickness)};
-  if (with_hole) outlines.push_back(dev_test::square_outline({0, 0}, kHoleHalf, 0, kThickness, true, 0));
-  return one_part(dev_test::make_layer(0, 0.0, kThickness, outlines), 0.0, kCentre, kKerfMm);
+  std::vector<LayerOutline> outlines{dev_test::square_outline({0, 0}, kCornerHalfSide, 0, kCornerThickness)};
+  if (with_hole) outlines.push_back(dev_test::square_outline({0, 0}, kHoleHalf, 0, kCornerThickness, true, 0));
+  return one_part(dev_test::make_layer(0, 0.0, kCornerThickness, outlines), 0.0, kCornerCentre, kCornerKerfMm);
 }
 
 ToolpathParams with(InsideCorners inside) {
   ToolpathParams p;
-  p.kerf_mm = kKerfMm;
+  p.kerf_mm = kCornerKerfMm;
   p.jet_compensation.mode = JetCompensationMode::full;
-  p.jet_compensation.kerf_by_material.emplace("aluminium", kKerf);
+  p.jet_compensation.kerf_by_material.emplace("aluminium", kCornerKerf);
   p.jet_compensation.corners.inside = inside;
   return p;
 }
@@ -44,9 +44,9 @@ struct Feeds {
 };
 
 Feeds straight_feed(const ToolpathParams& p) {
-  const double feed = *cut_feed_mm_per_s(p.jet, aluminium(), p.feed, kThickness, 0.0);
-  const double v_s = *separation_feed_mm_per_s(p.jet, aluminium(), p.feed, kThickness, 0.0);
-  return {feed, kerf_at(kKerf, kThickness, feed / v_s)->trail_back_mm};
+  const double feed = *cut_feed_mm_per_s(p.jet, aluminium(), p.feed, kCornerThickness, 0.0);
+  const double v_s = *separation_feed_mm_per_s(p.jet, aluminium(), p.feed, kCornerThickness, 0.0);
+  return {feed, kerf_at(kCornerKerf, kCornerThickness, feed / v_s)->trail_back_mm};
 }
 
 struct CutMove {
@@ -69,7 +69,7 @@ std::vector<CutMove> cut_moves(const SheetToolpath& tp, const ToolContour& c) {
 double to_corner(const std::vector<CutMove>& moves, const Eigen::Vector3d& p, double half) {
   double best = std::numeric_limits<double>::infinity();
   for (const CutMove& m : moves)
-    if ((m.to.head<2>() - kCentre).cwiseAbs().minCoeff() > half) best = std::min(best, (p - m.to).norm());
+    if ((m.to.head<2>() - kCornerCentre).cwiseAbs().minCoeff() > half) best = std::min(best, (p - m.to).norm());
   return best;
 }
 
@@ -87,7 +87,7 @@ TEST(JetCorners, ASquaresCornersAreSlowedToTheAllowanceForTheLagEitherSide) {
   const auto moves = cut_moves(*tp, tp->contours.back());
   int slow = 0, full = 0;
   for (const CutMove& m : moves) {
-    const double d = to_corner(moves, 0.5 * (m.from + m.to), kHalfSide);
+    const double d = to_corner(moves, 0.5 * (m.from + m.to), kCornerHalfSide);
     if (d < s.lag_mm - 1e-6) {
       EXPECT_NEAR(m.feed_mm_per_s, fraction * s.full_mm_per_s, 1e-3 * s.full_mm_per_s) << "within the lag of a corner";
       ++slow;

@@ -18,11 +18,11 @@ namespace {
 
 using Vec2 = Eigen::Vector2d;
 
-constexpr double kZBottom = 10.0, kThickness = 6.0;
+constexpr double kZBottom = 10.0, kSvgThickness = 6.0;
 
 CutLine line(const Vec2& top, const Vec2& bottom) {
   CutLine l;
-  l.top_mm = Eigen::Vector3d(top.x(), top.y(), kZBottom + kThickness);
+  l.top_mm = Eigen::Vector3d(top.x(), top.y(), kZBottom + kSvgThickness);
   l.bottom_mm = Eigen::Vector3d(bottom.x(), bottom.y(), kZBottom);
   l.tool_axis = (l.top_mm - l.bottom_mm).normalized();
   return l;
@@ -47,11 +47,11 @@ Polygon2 shifted(Polygon2 r, const Vec2& d) {
 
 // Layer 3: outer 0..40 at the top, 1..39 at the bottom (its freeing pass; a trim pass before it
 // is shifted so that drawing the wrong pass shows); hole 15..25 at the top, 14..26 at the bottom.
-BevelPlan make_plan() {
+BevelPlan svg_plan() {
   LayerPlan layer;
   layer.index = 3;
   layer.z_bottom_mm = kZBottom;
-  layer.thickness_mm = kThickness;
+  layer.thickness_mm = kSvgThickness;
   LayerOutline outer;
   outer.passes.push_back(pass(shifted(square(0, 40, true), {5, 5}), shifted(square(1, 39, true), {5, 5})));
   outer.passes.push_back(pass(square(0, 40, true), square(1, 39, true)));
@@ -66,14 +66,14 @@ BevelPlan make_plan() {
   return plan;
 }
 
-std::vector<Part> make_parts() {
+std::vector<Part> svg_parts() {
   Part p;
   p.layer_slot = 0;
   p.layer = 3;
   p.island = 1;
   p.outer = 0;
   p.holes = {1};
-  p.thickness_mm = kThickness;
+  p.thickness_mm = kSvgThickness;
   p.z_bottom_mm = kZBottom;
   p.footprint_mm = square(-1.5, 41.5, true);  // its centroid (20, 20) lies in the hole
   p.area_mm2 = 40 * 40 - 10 * 10;
@@ -83,10 +83,10 @@ std::vector<Part> make_parts() {
   return {p, q};
 }
 
-NestedSheet make_sheet() {
+NestedSheet svg_sheet() {
   NestedSheet s;
   s.index = 2;
-  s.thickness_mm = kThickness;
+  s.thickness_mm = kSvgThickness;
   s.length_mm = 300;
   s.width_mm = 200;
   s.material = "stainless 316L";
@@ -111,10 +111,10 @@ ToolMove move(MoveKind kind, const Vec2& xy, double z, int contour) {
 
 // Per placement: the hole, then the outer; each a rapid over and down, pierce, lead-in, two
 // cuts, lead-out, rapid up. Microjoints: one on each outer.
-SheetToolpath make_toolpath(const NestedSheet& sheet) {
+SheetToolpath svg_toolpath(const NestedSheet& sheet) {
   SheetToolpath tp;
   tp.sheet = sheet.index;
-  tp.thickness_mm = kThickness;
+  tp.thickness_mm = kSvgThickness;
   for (int k = 0; k < static_cast<int>(sheet.placements.size()); ++k) {
     const auto& pl = sheet.placements[static_cast<std::size_t>(k)];
     for (const bool hole : {true, false}) {
@@ -148,11 +148,11 @@ SheetToolpath make_toolpath(const NestedSheet& sheet) {
   return tp;
 }
 
-struct Fixture {
-  BevelPlan plan = make_plan();
-  std::vector<Part> parts = make_parts();
-  NestedSheet sheet = make_sheet();
-  SheetToolpath tp = make_toolpath(sheet);
+struct SvgFixture {
+  BevelPlan plan = svg_plan();
+  std::vector<Part> parts = svg_parts();
+  NestedSheet sheet = svg_sheet();
+  SheetToolpath tp = svg_toolpath(sheet);
   SheetSvgParams params{"A&B <x>.stl", 0.0, 6.0, true};
 
   std::string svg() const { return sheet_svg(plan, parts, sheet, tp, params); }
@@ -215,7 +215,7 @@ void expect_ring(const xml_mini::Element& e, const Polygon2& expected, const std
 }
 
 TEST(SheetSvg, IsWellFormedSvgInMillimetres) {
-  const Fixture f;
+  const SvgFixture f;
   const std::string svg = f.svg();
   ASSERT_EQ(svg.rfind("<?xml", 0), 0u);
   const auto root = parse_ok(svg);
@@ -246,7 +246,7 @@ TEST(SheetSvg, TheCheckerRejectsBrokenDocuments) {
 }
 
 TEST(SheetSvg, SheetRectangleInAYUpFrame) {
-  const Fixture f;
+  const SvgFixture f;
   const auto root = parse_ok(f.svg());
   const auto* g = by_id(root, "sheet");
   ASSERT_NE(g, nullptr);
@@ -260,7 +260,7 @@ TEST(SheetSvg, SheetRectangleInAYUpFrame) {
 }
 
 TEST(SheetSvg, TopAndBottomContoursOfTheFreeingPassArePlaced) {
-  const Fixture f;
+  const SvgFixture f;
   const auto root = parse_ok(f.svg());
   for (std::size_t k = 0; k < f.sheet.placements.size(); ++k) {
     const auto& pl = f.sheet.placements[k];
@@ -296,7 +296,7 @@ TEST(SheetSvg, TopAndBottomContoursOfTheFreeingPassArePlaced) {
 }
 
 TEST(SheetSvg, OneUprightLabelPerPlacementInsideThePart) {
-  const Fixture f;
+  const SvgFixture f;
   const auto root = parse_ok(f.svg());
   const auto labels = root.find("text", "label");
   ASSERT_EQ(labels.size(), 2u);
@@ -319,7 +319,7 @@ TEST(SheetSvg, OneUprightLabelPerPlacementInsideThePart) {
 }
 
 TEST(SheetSvg, PiercesLeadsMicrojointsAndRapids) {
-  Fixture f;
+  SvgFixture f;
   const auto root = parse_ok(f.svg());
   const auto groups = root.find("g", "toolpath");
   ASSERT_EQ(groups.size(), 1u);
@@ -352,7 +352,7 @@ TEST(SheetSvg, PiercesLeadsMicrojointsAndRapids) {
 }
 
 TEST(SheetSvg, LegendStatesTheSheetAndEscapesTheTitle) {
-  const Fixture f;
+  const SvgFixture f;
   const std::string svg = f.svg();
   EXPECT_NE(svg.find("A&amp;B &lt;x&gt;.stl"), std::string::npos);
   EXPECT_EQ(svg.find("A&B"), std::string::npos);
@@ -379,7 +379,7 @@ TEST(SheetSvg, LegendStatesTheSheetAndEscapesTheTitle) {
 }
 
 TEST(SheetSvg, EscapesMaterialAndDropsControlCharacters) {
-  Fixture f;
+  SvgFixture f;
   f.sheet.material = "S235 \"JR\" & 'co'\x01";
   f.params.title.clear();
   f.params.estimated_time_s = 3725.4;
@@ -392,7 +392,7 @@ TEST(SheetSvg, EscapesMaterialAndDropsControlCharacters) {
 }
 
 TEST(SheetSvg, SkipsPlacementsOfUnknownParts) {
-  Fixture f;
+  SvgFixture f;
   f.sheet.placements.push_back(Placement{7, 0.0, {0, 0}});
   const auto root = parse_ok(f.svg());
   EXPECT_EQ(root.find("text", "label").size(), 2u);

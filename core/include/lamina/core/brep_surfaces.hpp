@@ -45,6 +45,7 @@ struct BrepData {
   std::vector<BrepFace> faces;
   std::vector<BrepSolid> solids;
   std::string length_unit;  // the file's own length unit, as it names it ("INCH", "MILLIMETRE"); corners are mm
+  double chord_tolerance_mm = 0;  // the tessellation's: no triangle farther than this from its face
 };
 
 }  // namespace lamina

@@ -3,6 +3,7 @@
 // so never renumber; only append.
 #include <cstdint>
 #include <string>
+#include <utility>
 
 namespace lamina {
 
@@ -25,5 +26,8 @@ struct Error {
   ErrorCode code;
   std::string message;  // says what is wrong and where (file, line, byte offset, facet)
 };
+
+// A parameter outside its domain, said in `message`.
+inline Error invalid_argument(std::string message) { return {ErrorCode::invalid_argument, std::move(message)}; }
 
 }  // namespace lamina

@@ -70,6 +70,9 @@ struct MeshSummary {
   int surfaces = 0;
   std::size_t boundary_edges = 0;
   std::size_t nonmanifold_edges = 0;
+  // How far the turned model was lowered to put its lowest point at z = 0: two tessellations of
+  // one B-rep (their lowest vertices differ by up to the chord) share a frame through it.
+  double lowered_mm = 0.0;
 };
 
 // One shell: a connected set of facets joined through manifold edges (exactly two facets).
@@ -109,5 +112,10 @@ Eigen::Matrix3d build_frame_rotation(const MeshParams& params);
 // Weld, repair, orient, find shells and surfaces. Fails only when nothing usable is left
 // (no finite, non-degenerate facet); every other problem becomes a Defect.
 std::expected<Mesh, Error> build_mesh(const TriangleSoup& soup, const MeshParams& params);
+
+// `other`, built from another tessellation of the same model with the same params, moved into
+// `frame`'s frame: each was lowered by its own lowest vertex (summary.lowered_mm), which differ by
+// up to the chord where the lowest point is on a curved face.
+Mesh in_frame_of(Mesh other, const Mesh& frame);
 
 }  // namespace lamina

@@ -20,6 +20,7 @@
 
 #include <expected>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -57,6 +58,7 @@ struct ModelEcho {
   std::string units = "mm", axis = "z";
   std::vector<double> direction;  // empty: the axis
   double read_s = 0.0, topology_s = 0.0;
+  std::optional<ReportCad> cad;  // what a STEP / IGES file told the plan (the report's model.cad)
 };
 
 struct PlanJobRequest {
@@ -64,6 +66,10 @@ struct PlanJobRequest {
   std::optional<CamSettings> cam;     // none: stop after the stack (no nesting, programs, drawings)
   ModelEcho model;
   std::vector<std::string> warnings;  // the caller's, about the model; first in the report
+  // The surface the report's deviation is measured against, in the planned mesh's frame: a finer
+  // tessellation of a B-rep (the planned one is up to its chord off the CAD surface). Null: the
+  // planned mesh. The layering's and bevels' own estimates always use the planned mesh.
+  std::shared_ptr<const Mesh> deviation_reference;
 };
 
 // The phases of plan_job, in the order they run. Errors say in which one they arose.

@@ -18,10 +18,28 @@
 
 namespace lamina {
 
+// What a STEP or IGES file told the plan (docs/step.md): its unit, how finely it was tessellated,
+// whose normals the bevel plan read, its solids and how many faces of each surface kind.
+struct ReportCadSolid {
+  std::string name;
+  std::int64_t faces = 0, triangles = 0;
+};
+struct ReportCad {
+  std::string length_unit;          // as the file names it ("MILLIMETRE", "INCH"); empty: not said
+  double chord_tolerance_mm = 0.0;  // the tessellation's largest distance from the B-rep surface
+  std::string surface_normals;      // "exact" (the B-rep surface's) or "facet" (the triangles')
+  // The deviation was measured against the file tessellated to this chord (a tenth of the
+  // planned one's by default); null: against the planned tessellation itself.
+  std::optional<double> deviation_chord_tolerance_mm;
+  std::vector<ReportCadSolid> solids;
+  std::vector<std::pair<std::string, std::int64_t>> surface_kinds;  // kind → faces, kinds present
+};
+
 struct ReportModel {
   std::string file, format;
   std::int64_t triangles = 0;
   double volume_mm3 = 0.0, height_mm = 0.0;
+  std::optional<ReportCad> cad;  // a B-rep file only; left out of the file for a mesh
 };
 
 struct ReportStockSheet {  // a sheet (type) of the rack; null: not given
@@ -201,6 +219,8 @@ struct PlanReport {
 
 // report.json's text: two-space indented, keys in the order above, a newline at the end.
 std::string plan_report_json(const PlanReport& report);
+// The report's model.cad alone, as it writes it (`lamina check --json` gives the same object).
+std::string report_cad_json(const ReportCad& cad);
 
 // Reads report.json back. ErrorCode::parse_error naming the path of what does not match
 // ("report.json: sheets[1].program: missing", "…: expected a number, found a string").

@@ -1,6 +1,7 @@
 #pragma once
 // The job as the daemon keeps it: plain data, stored in SQLite (job_store.hpp), sent over
 // JSON-RPC (docs/api.md). States and their transitions: docs/api.md "Job states".
+#include <chrono>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -9,6 +10,12 @@
 #include <nlohmann/json.hpp>
 
 namespace lamina::daemon {
+
+// The wall clock's time as the job's timestamps hold it (`*_unix_ms`).
+inline std::int64_t now_unix_ms() {
+  using namespace std::chrono;
+  return duration_cast<milliseconds>(system_clock::now().time_since_epoch()).count();
+}
 
 enum class JobState {
   queued,         // accepted, waiting for the planner
