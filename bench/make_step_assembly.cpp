@@ -2,7 +2,8 @@
 // size benchmark (docs/performance.md, "STEP: a 50 MB assembly"). Every part is its own product
 // (a plate with filleted edges, a tube or a filleted block, each of its own size), so the file
 // grows with N (about 25 KB a part) rather than repeating one product by reference, as a real
-// machine's assembly of many different parts does.
+// machine's assembly of many different parts does. Parts stand 100 mm apart on a grid 40 wide
+// (the largest is 82 mm long at N = 1050): no two overlap.
 #include "occt_shapes.hpp"
 
 #include <fmt/format.h>
@@ -36,7 +37,7 @@ int main(int argc, char** argv) {
     const int n = std::stoi(argv[2]);
     std::vector<PlacedPart> parts;
     for (int i = 0; i < n; ++i)
-      parts.push_back({fmt::format("part {}", i + 1), part_number(i), 60.0 * (i % 40), 60.0 * (i / 40), 0});
+      parts.push_back({fmt::format("part {}", i + 1), part_number(i), 100.0 * (i % 40), 100.0 * (i / 40), 0});
     write_assembly_of(parts, argv[1]);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "make_step_assembly: %s\n", e.what());

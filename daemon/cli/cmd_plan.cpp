@@ -134,13 +134,13 @@ int run_plan(const PlanOptions& o, const CamOptions& cam_options) {
   }
   // A typo in --out must not cost a full plan; nothing is created before the plan is whole.
   if (auto ok = check_out_dir(o.out_dir); !ok) return report_error(ok.error());
-  // A B-rep file is read twice: once to plan, once finer for the deviation's reference.
-  const bool reads_reference = is_cad_path(o.model.path) && o.deviation_chord_mm.value_or(1) > 0;
-  PlanProgress progress(o.progress_fd, (request.cam ? 7 : 5) + (reads_reference ? 1 : 0));
-
-  progress.phase("reading the model");
   ModelOptions model_options = o.model;
   if (!model_options.chord_tolerance_mm) model_options.chord_tolerance_mm = o.tolerance_mm / 10;
+  // A B-rep file is read twice: once to plan, once finer for the deviation's reference.
+  const std::optional<ModelOptions> reference_options = deviation_reference_options(o, model_options);
+  PlanProgress progress(o.progress_fd, (request.cam ? 7 : 5) + (reference_options ? 1 : 0));
+
+  progress.phase("reading the model");
   auto model = load_model(model_options);
   if (!model) return report_error(model.error());
   const Mesh& mesh = model->mesh;
@@ -148,14 +148,13 @@ int run_plan(const PlanOptions& o, const CamOptions& cam_options) {
     return report_error({ErrorCode::invalid_argument,
                          fmt::format("{} is not usable as a solid (see lamina check {})", o.model.path, o.model.path)});
   request.model = {o.model.path, model->format, o.model.units, o.model.axis, o.model.direction, model->read_s,
-                   model->topology_s, cad_report(*model, model_options)};
-  if (request.model.cad && reads_reference) {
-    const double chord = o.deviation_chord_mm.value_or(*model_options.chord_tolerance_mm / 10);
-    progress.phase("reading the reference surface");
-    auto reference = load_reference(model_options, mesh, chord);
+                   model->topology_s, cad_report(*model, model_options), std::nullopt};
+  if (reference_options) {
+    progress.phase("reading the deviation's reference");
+    auto reference = load_reference(*reference_options, mesh);
     if (!reference) return report_error(reference.error());
-    request.deviation_reference = std::move(*reference);
-    request.model.cad->deviation_chord_tolerance_mm = chord;
+    request.deviation_reference = std::move(reference->mesh);
+    request.model.deviation_reference = std::move(reference->echo);
   }
   request.warnings = model_warnings(request.settings, mesh, o, request.cam);
 

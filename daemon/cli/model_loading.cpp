@@ -74,8 +74,10 @@ std::expected<LoadedModel, Error> load_model(const ModelOptions& options) {
 std::optional<ReportCad> cad_report(const LoadedModel& model, const ModelOptions& options) {
   if (!model.brep) return std::nullopt;
   const BrepData& b = *model.brep;
-  ReportCad cad{.length_unit = b.length_unit, .chord_tolerance_mm = b.chord_tolerance_mm,
-                .surface_normals = options.surface_normals};
+  ReportCad cad;
+  cad.length_unit = b.length_unit;
+  cad.chord_tolerance_mm = b.chord_tolerance_mm;
+  cad.surface_normals = options.surface_normals;
   for (const BrepSolid& s : b.solids)
     cad.solids.push_back({s.name, static_cast<std::int64_t>(s.faces), static_cast<std::int64_t>(s.triangles)});
   std::map<SurfaceKind, std::int64_t> faces_of_kind;
@@ -84,13 +86,17 @@ std::optional<ReportCad> cad_report(const LoadedModel& model, const ModelOptions
   return cad;
 }
 
-std::expected<std::shared_ptr<const Mesh>, Error> load_reference(const ModelOptions& options, const Mesh& planned,
-                                                                  double chord_mm) {
-  ModelOptions fine = options;
-  fine.chord_tolerance_mm = chord_mm;
-  auto model = load_model(fine);
+std::expected<DeviationReference, Error> load_reference(const ModelOptions& options, const Mesh& planned) {
+  auto model = load_model(options);
   if (!model) return std::unexpected(model.error());
-  return std::make_shared<const Mesh>(in_frame_of(std::move(model->mesh), planned));
+  if (!model->mesh.usable())
+    return std::unexpected(Error{ErrorCode::invalid_argument,
+                                 fmt::format("the deviation's reference {} is not usable as a solid (see lamina check {})",
+                                             options.path, options.path)});
+  ReportDeviationReference echo{options.path, model->format, static_cast<std::int64_t>(model->mesh.summary.triangles),
+                                std::nullopt};
+  if (model->brep) echo.chord_tolerance_mm = model->brep->chord_tolerance_mm;
+  return DeviationReference{std::make_shared<const Mesh>(in_frame_of(std::move(model->mesh), planned)), std::move(echo)};
 }
 
 std::vector<std::string> cad_lines(const ReportCad& cad) {
@@ -104,8 +110,15 @@ std::vector<std::string> cad_lines(const ReportCad& cad) {
       fmt::format("B-rep      {} solid{}, {} faces ({}); unit {}; tessellated to {:g} mm; {} normals", cad.solids.size(),
                   cad.solids.size() == 1 ? "" : "s", faces, kinds, cad.length_unit.empty() ? "not said (mm)" : cad.length_unit,
                   cad.chord_tolerance_mm, cad.surface_normals)};
-  for (const ReportCadSolid& s : cad.solids)
+  // An assembly of a thousand parts is a thousand lines: the first ones, then how many more
+  // (all of them are in the JSON).
+  constexpr std::size_t kSolidLines = 20;
+  for (std::size_t i = 0; i < cad.solids.size() && i < kSolidLines; ++i) {
+    const ReportCadSolid& s = cad.solids[i];
     lines.push_back(fmt::format("  solid    {}: {} faces, {} triangles", s.name.empty() ? "(unnamed)" : s.name, s.faces, s.triangles));
+  }
+  if (cad.solids.size() > kSolidLines)
+    lines.push_back(fmt::format("  …        and {} more solids (--json lists them all)", cad.solids.size() - kSolidLines));
   return lines;
 }
 

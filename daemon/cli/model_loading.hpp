@@ -45,10 +45,14 @@ std::expected<LoadedModel, Error> load_model(const ModelOptions& options);
 // (model.cad); nullopt for a mesh. cad_lines: the same for a person, one line each.
 std::optional<ReportCad> cad_report(const LoadedModel& model, const ModelOptions& options);
 std::vector<std::string> cad_lines(const ReportCad& cad);
-// The same file tessellated again to `chord_mm`, in `planned`'s frame (the planned deviation's
-// reference: the CAD surface to within that chord).
-std::expected<std::shared_ptr<const Mesh>, Error> load_reference(const ModelOptions& options, const Mesh& planned,
-                                                                  double chord_mm);
+// What a plan's deviation is measured against, read and put in `planned`'s frame: the same B-rep
+// file tessellated finer (the CAD surface to within that chord), or another file of the same part
+// in the same coordinates (`lamina plan part.stl --deviation-against part.step`).
+struct DeviationReference {
+  std::shared_ptr<const Mesh> mesh;
+  ReportDeviationReference echo;
+};
+std::expected<DeviationReference, Error> load_reference(const ModelOptions& options, const Mesh& planned);
 
 // A size that suggests the wrong --units (issue 17, item 8): a part under 10 mm at its largest
 // read as mm (an inch file: 25.4 times that), or a part larger than the sheet read as inches

@@ -3,6 +3,8 @@
 #include "model_options.hpp"
 #include "stock_config.hpp"
 
+#include "lamina/core/mesh_io.hpp"
+
 #include <fmt/format.h>
 
 #include <charconv>
@@ -97,6 +99,9 @@ void add_plan_options(CLI::App& cmd, PlanOptions& o) {
                  "STEP / IGES: measure the deviation against the file tessellated to this chord, mm (0: against the "
                  "planned tessellation; default a tenth of its chord: the CAD surface to within that)")
       ->check(CLI::Range(0.0, 10.0));
+  cmd.add_option("--deviation-against", o.deviation_against,
+                 "Measure the deviation against this file of the same part, in the same coordinates (e.g. the "
+                 "customer's STEP for a plan of its STL)");
   cmd.add_option("--compare-strategies", o.compare_strategies,
                  "Also measure the deviation of the strategies not chosen, on the same layering (true/false; it "
                  "about doubles the time)")
@@ -116,6 +121,30 @@ void add_plan_options(CLI::App& cmd, PlanOptions& o) {
       "Exit status: 0 planned, 1 the model, the stock file, nesting or the output folder failed, 2 usage error\n"
       "(also a value the model makes absurd: a sheet thicker than the part, a grid too fine for its height).\n"
       "A run that fails leaves --out as it found it.");
+}
+
+std::optional<ModelOptions> deviation_reference_options(const PlanOptions& o, const ModelOptions& planned) {
+  const bool against_other = !o.deviation_against.empty();
+  const std::string& path = against_other ? o.deviation_against : planned.path;
+  if (!is_cad_path(path)) {
+    if (!against_other) return std::nullopt;  // a mesh plan is measured against its own mesh
+    ModelOptions other = planned;
+    other.path = path;
+    return other;
+  }
+  // A B-rep: ten times finer than the plan's tessellation unless told (0: the planned one's; for
+  // the model itself, the planned mesh).
+  const double planned_chord = planned.chord_tolerance_mm.value_or(o.tolerance_mm / 10);
+  double chord = o.deviation_chord_mm.value_or(planned_chord / 10);
+  if (chord <= 0) {
+    if (!against_other) return std::nullopt;
+    chord = planned_chord;
+  }
+  ModelOptions fine = planned;
+  fine.path = path;
+  fine.units = "mm";  // a STEP file names its own
+  fine.chord_tolerance_mm = chord;
+  return fine;
 }
 
 std::expected<PlanSettings, Error> resolve_plan_settings(const PlanOptions& o) {

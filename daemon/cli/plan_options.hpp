@@ -39,7 +39,13 @@ struct PlanOptions {
   // STEP / IGES: the chord of the tessellation the deviation is measured against (0: the planned
   // tessellation itself). Unset: a tenth of the planned one's.
   std::optional<double> deviation_chord_mm;
+  std::string deviation_against;  // --deviation-against FILE: another file of the part (its STEP)
 };
+
+// What the deviation is measured against (--deviation-against, or a B-rep model tessellated
+// finer), as the options to read it with; nullopt: the planned mesh itself. `planned`: the model's
+// options with the planning chord filled in.
+std::optional<ModelOptions> deviation_reference_options(const PlanOptions& o, const ModelOptions& planned);
 
 // Validated, in core units: PlanSettings (lamina/core/plan_job.hpp).
 

@@ -162,7 +162,7 @@ PlanReport make_plan_report(const Mesh& mesh, const PlanJobRequest& request, con
   const MeshSummary& s = mesh.summary;
   PlanReport r;
   r.model = {request.model.file, request.model.format, static_cast<std::int64_t>(s.triangles), s.volume_mm3,
-             s.bbox_max_mm.z() - s.bbox_min_mm.z(), request.model.cad};
+             s.bbox_max_mm.z() - s.bbox_min_mm.z(), request.model.cad, request.model.deviation_reference};
   r.settings = settings_report(request);
   const auto& spans = result.layering.layers;
   for (std::size_t i = 0; i < result.plan.layers.size(); ++i)

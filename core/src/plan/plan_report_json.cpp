@@ -36,17 +36,24 @@ template <>
 struct Fields<ReportCad> {
   static constexpr auto all =
       std::tuple{Field{"length_unit", &ReportCad::length_unit}, Field{"chord_tolerance_mm", &ReportCad::chord_tolerance_mm},
-                 Field{"surface_normals", &ReportCad::surface_normals},
-                 Field{"deviation_chord_tolerance_mm", &ReportCad::deviation_chord_tolerance_mm}, Field{"solids", &ReportCad::solids},
+                 Field{"surface_normals", &ReportCad::surface_normals}, Field{"solids", &ReportCad::solids},
                  Field{"surface_kinds", &ReportCad::surface_kinds}};
+};
+template <>
+struct Fields<ReportDeviationReference> {
+  using R = ReportDeviationReference;
+  static constexpr auto all = std::tuple{Field{"file", &R::file}, Field{"format", &R::format},
+                                         Field{"triangles", &R::triangles},
+                                         Field{"chord_tolerance_mm", &R::chord_tolerance_mm}};
 };
 template <>
 struct Fields<ReportModel> {
   static constexpr auto all = std::tuple{Field{"file", &ReportModel::file}, Field{"format", &ReportModel::format},
                                          Field{"triangles", &ReportModel::triangles},
                                          Field{"volume_mm3", &ReportModel::volume_mm3},
-                                         Field{"height_mm", &ReportModel::height_mm}, Field{"cad", &ReportModel::cad}};
-  static constexpr bool omit_empty(std::string_view key) { return key == "cad"; }
+                                         Field{"height_mm", &ReportModel::height_mm}, Field{"cad", &ReportModel::cad},
+                                         Field{"deviation_reference", &ReportModel::deviation_reference}};
+  static constexpr bool omit_empty(std::string_view key) { return key == "cad" || key == "deviation_reference"; }
 };
 template <>
 struct Fields<ReportStockSheet> {

@@ -33,7 +33,7 @@ PlanJobRequest request(bool with_programs) {
   q.settings.tilt_max_deg = 60.0;
   q.settings.tilt_max_rad = 60.0 * 3.14159265358979 / 180.0;
   q.settings.deviation_step_mm = 0.25;
-  q.model = {"ball.stl", "stl-binary", "mm", "z", {}, 0.0, 0.0};
+  q.model = {"ball.stl", "stl-binary", "mm", "z", {}, 0.0, 0.0, std::nullopt, std::nullopt};
   if (with_programs) {
     CamSettings cam;
     cam.materials.materials.emplace("aluminium 6061-T6", Material{"aluminium 6061-T6", 2700, 0.0, 213});
@@ -113,17 +113,22 @@ TEST(PlanJob, TheAsCutFiguresReadBackAndAreLeftOutWithoutThem) {
 }
 
 // A STEP model's plan says what the file told it (model.cad: unit, chord, normals, solids, surface
-// kinds); it reads back, and a mesh's report leaves the key out.
+// kinds) and what its deviation was measured against; both read back, and a mesh's report
+// measured against itself leaves the keys out.
 TEST(PlanJob, TheCadFiguresReadBackAndAreLeftOutForAMesh) {
   PlanReport report = planned().report;
   EXPECT_EQ(plan_report_json(report).find("\"cad\""), std::string::npos);
-  report.model.cad = ReportCad{"INCH", 0.005, "exact", 0.0005, {{"fork", 118, 4000}, {"pin", 3, 96}}, {{"plane", 40}, {"torus", 81}}};
+  report.model.cad = ReportCad{"INCH", 0.005, "exact", {{"fork", 118, 4000}, {"pin", 3, 96}}, {{"plane", 40}, {"torus", 81}}};
+  report.model.deviation_reference = ReportDeviationReference{"fork.step", "step", 40000, 0.0005};
   const std::string text = plan_report_json(report);
   auto back = parse_plan_report(text);
   ASSERT_TRUE(back) << back.error().message;
   EXPECT_EQ(plan_report_json(*back), text);
   ASSERT_TRUE(back->model.cad);
   EXPECT_EQ(back->model.cad->solids.at(1).name, "pin");
+  ASSERT_TRUE(back->model.deviation_reference);
+  EXPECT_EQ(back->model.deviation_reference->chord_tolerance_mm, 0.0005);
+  EXPECT_EQ(plan_report_json(planned().report).find("deviation_reference"), std::string::npos);
   EXPECT_EQ(back->model.cad->surface_kinds.at(1), (std::pair<std::string, std::int64_t>{"torus", 81}));
   EXPECT_EQ(nlohmann::json::parse(report_cad_json(*report.model.cad)), nlohmann::json::parse(text)["model"]["cad"]);
 }

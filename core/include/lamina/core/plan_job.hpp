@@ -59,6 +59,7 @@ struct ModelEcho {
   std::vector<double> direction;  // empty: the axis
   double read_s = 0.0, topology_s = 0.0;
   std::optional<ReportCad> cad;  // what a STEP / IGES file told the plan (the report's model.cad)
+  std::optional<ReportDeviationReference> deviation_reference;  // with PlanJobRequest::deviation_reference
 };
 
 struct PlanJobRequest {

@@ -28,11 +28,17 @@ struct ReportCad {
   std::string length_unit;          // as the file names it ("MILLIMETRE", "INCH"); empty: not said
   double chord_tolerance_mm = 0.0;  // the tessellation's largest distance from the B-rep surface
   std::string surface_normals;      // "exact" (the B-rep surface's) or "facet" (the triangles')
-  // The deviation was measured against the file tessellated to this chord (a tenth of the
-  // planned one's by default); null: against the planned tessellation itself.
-  std::optional<double> deviation_chord_tolerance_mm;
   std::vector<ReportCadSolid> solids;
   std::vector<std::pair<std::string, std::int64_t>> surface_kinds;  // kind → faces, kinds present
+};
+
+// What the report's deviation was measured against when it is not the planned mesh: a STEP
+// file tessellated finer than for planning (the CAD surface to within that chord), or another
+// file of the same part (--deviation-against: a mesh plan measured against the customer's STEP).
+struct ReportDeviationReference {
+  std::string file, format;
+  std::int64_t triangles = 0;
+  std::optional<double> chord_tolerance_mm;  // a STEP / IGES reference's; null for a mesh
 };
 
 struct ReportModel {
@@ -40,6 +46,7 @@ struct ReportModel {
   std::int64_t triangles = 0;
   double volume_mm3 = 0.0, height_mm = 0.0;
   std::optional<ReportCad> cad;  // a B-rep file only; left out of the file for a mesh
+  std::optional<ReportDeviationReference> deviation_reference;  // left out: the planned mesh
 };
 
 struct ReportStockSheet {  // a sheet (type) of the rack; null: not given
