@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <span>
 
 namespace lamina {
 
@@ -86,33 +87,56 @@ bool clip_to_grid(const BoxGrid& grid, const Eigen::Vector2d& origin, const Eige
 }
 }  // namespace
 
-std::optional<LineCrossing> SectionLines::exit_crossing(const Eigen::Vector2d& origin, const Eigen::Vector2d& direction,
-                                                        double u_min, double u_max, CrossingPick pick) const {
-  if (segments_.empty() || !(u_max >= u_min)) return std::nullopt;
-  // Clip the query to the grid's box, then walk its cells (Amanatides & Woo).
-  double t0 = u_min, t1 = u_max;
-  if (!clip_to_grid(grid_, origin, direction, t0, t1)) return std::nullopt;
-  const Eigen::Vector2d& grid_origin = grid_.origin();
-  const double cell_mm = grid_.cell_mm();
-  const int nx = grid_.nx(), ny = grid_.ny();
+namespace {
 
-  const Eigen::Vector2d start = origin + t0 * direction;
-  int cx = grid_.column(start.x()), cy = grid_.row(start.y());
-  const int step_x = direction.x() > 0 ? 1 : -1;
-  const int step_y = direction.y() > 0 ? 1 : -1;
+// Walks the cells the line origin + t·dir crosses for t in [t0, t1], in order (Amanatides & Woo),
+// calling visit(cell, t_entry) with the t at which the line enters the cell; stops when visit
+// returns false.
+template <class Visit>
+void walk_cells(const BoxGrid& grid, const Eigen::Vector2d& origin, const Eigen::Vector2d& dir, double t0, double t1,
+                Visit&& visit) {
+  if (!(t1 >= t0) || !clip_to_grid(grid, origin, dir, t0, t1)) return;
+  const Eigen::Vector2d& grid_origin = grid.origin();
+  const double cell_mm = grid.cell_mm();
+  const int nx = grid.nx(), ny = grid.ny();
+  const Eigen::Vector2d start = origin + t0 * dir;
+  int cx = grid.column(start.x()), cy = grid.row(start.y());
+  const int step_x = dir.x() > 0 ? 1 : -1;
+  const int step_y = dir.y() > 0 ? 1 : -1;
   const double inf = std::numeric_limits<double>::infinity();
-  const double dt_x = std::abs(direction.x()) > 1e-300 ? cell_mm / std::abs(direction.x()) : inf;
-  const double dt_y = std::abs(direction.y()) > 1e-300 ? cell_mm / std::abs(direction.y()) : inf;
+  const double dt_x = std::abs(dir.x()) > 1e-300 ? cell_mm / std::abs(dir.x()) : inf;
+  const double dt_y = std::abs(dir.y()) > 1e-300 ? cell_mm / std::abs(dir.y()) : inf;
   auto boundary_t = [&](int c, int step, int k) {
-    if (std::abs(direction[k]) < 1e-300) return inf;
+    if (std::abs(dir[k]) < 1e-300) return inf;
     const double edge = grid_origin[k] + (c + (step > 0 ? 1 : 0)) * cell_mm;
-    return (edge - origin[k]) / direction[k];
+    return (edge - origin[k]) / dir[k];
   };
   double next_x = boundary_t(cx, step_x, 0);
   double next_y = boundary_t(cy, step_y, 1);
+  double t_entry = t0;
+  while (visit(grid.cell(cx, cy), t_entry)) {
+    t_entry = std::min(next_x, next_y);
+    if (t_entry > t1) break;
+    if (next_x < next_y) {
+      cx += step_x;
+      next_x += dt_x;
+      if (cx < 0 || cx >= nx) break;
+    } else {
+      cy += step_y;
+      next_y += dt_y;
+      if (cy < 0 || cy >= ny) break;
+    }
+  }
+}
 
+}  // namespace
+
+std::optional<LineCrossing> SectionLines::exit_crossing(const Eigen::Vector2d& origin, const Eigen::Vector2d& direction,
+                                                        double u_min, double u_max, CrossingPick pick) const {
+  if (segments_.empty() || !(u_max >= u_min)) return std::nullopt;
+  const double inf = std::numeric_limits<double>::infinity();
   std::optional<LineCrossing> best;
-  double best_key = inf;
+  double best_key = inf;  // |u| (nearest_zero) or −u (largest): smaller is better
   std::uint32_t seen[64];
   int seen_count = 0;
   auto consider = [&](std::uint32_t idx) {
@@ -132,25 +156,29 @@ std::optional<LineCrossing> SectionLines::exit_crossing(const Eigen::Vector2d& o
     const Eigen::Vector2d left(-e.y(), e.x());
     if (left.dot(direction) >= 0.0) return;
     const double key = pick == CrossingPick::largest ? -u : std::abs(u);
-    if (key < best_key) {
+    // Equal keys (u = ±a from the middle of a slot) go to the smaller u, whatever the walk's order.
+    if (key < best_key || (key == best_key && best && u < best->u_mm)) {
       best_key = key;
       best = LineCrossing{u, s.normal, s.surface_id, s.facet};
     }
   };
-  while (true) {
-    for (const std::uint32_t idx : grid_.items(grid_.cell(cx, cy))) consider(idx);
+  // Each walk runs where its t is the key (|u| outwards from u = 0, or −u inwards from u_max):
+  // a crossing not yet found lies in a cell not yet entered, so at a key of at least that cell's
+  // entry, and the walk stops once the entry is past the best key found.
+  auto visit = [&](std::span<const std::uint32_t> items, double t_entry) {
+    if (t_entry > best_key) return false;
+    for (const std::uint32_t idx : items) consider(idx);
     if (seen_count >= 64) seen_count = 0;  // long walks: forget old ones (re-testing is harmless)
-    const double t_exit = std::min(next_x, next_y);
-    if (t_exit > t1) break;
-    if (next_x < next_y) {
-      cx += step_x;
-      next_x += dt_x;
-      if (cx < 0 || cx >= nx) break;
-    } else {
-      cy += step_y;
-      next_y += dt_y;
-      if (cy < 0 || cy >= ny) break;
-    }
+    return true;
+  };
+  auto walk = [&](const Eigen::Vector2d& dir, double t0, double t1) {
+    walk_cells(grid_, origin, dir, t0, t1, [&](std::size_t cell, double t) { return visit(grid_.items(cell), t); });
+  };
+  if (pick == CrossingPick::largest) {
+    walk(-direction, -u_max, -u_min);
+  } else {
+    walk(direction, std::max(0.0, u_min), u_max);
+    walk(-direction, std::max(0.0, -u_max), -u_min);
   }
   return best;
 }
