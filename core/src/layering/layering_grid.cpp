@@ -212,7 +212,6 @@ void Estimator::fill_samples(int slice, std::size_t station) {
   const std::size_t width = static_cast<std::size_t>(c.hi - c.lo + 1);
   Sample* out = c.samples.data() + station * width;
   const double w_max = search_width(static_cast<int>(thicknesses_.size()) - 1);
-  const double z0 = slices_[static_cast<std::size_t>(slice)].z_mm;
   for (int j = c.hi; j >= c.lo; --j) {
     Sample& s = out[j - c.lo];
     if (same_as_next_[static_cast<std::size_t>(j)] && j < c.hi) {
@@ -220,12 +219,10 @@ void Estimator::fill_samples(int slice, std::size_t station) {
       continue;
     }
     const SectionLines& lines = lines_[static_cast<std::size_t>(j)];
-    // The nearest crossing within a narrow window is the nearest within the full one; most
-    // surfaces are found there, which saves walking the whole width.
-    const double dz = std::abs(slices_[static_cast<std::size_t>(j)].z_mm - z0);
-    const double w1 = std::min(w_max, 2 * step_ + dz * tan_reach_);
-    auto hit = lines.exit_crossing(st.point, st.normal, -w1, w1, CrossingPick::nearest_zero);
-    if (!hit && w1 < w_max) hit = lines.exit_crossing(st.point, st.normal, -w_max, w_max, CrossingPick::nearest_zero);
+    // One query over the full width: it walks outwards from the station and stops past the
+    // nearest crossing (a narrow first query, then the full one when it missed, walked the
+    // narrow window twice).
+    const auto hit = lines.exit_crossing(st.point, st.normal, -w_max, w_max, CrossingPick::nearest_zero);
     if (hit) {
       s.u = hit->u_mm;
       s.slope = profile_slope(hit->normal, st.normal);
