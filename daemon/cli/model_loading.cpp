@@ -88,7 +88,7 @@ std::optional<ReportCad> cad_report(const LoadedModel& model, const ModelOptions
 
 std::expected<DeviationReference, Error> load_reference(const ModelOptions& options, const Mesh& planned) {
   auto model = load_model(options);
-  if (!model) return std::unexpected(model.error());
+  if (!model) return std::unexpected(Error{model.error().code, "the deviation's reference: " + model.error().message});
   if (!model->mesh.usable())
     return std::unexpected(Error{ErrorCode::invalid_argument,
                                  fmt::format("the deviation's reference {} is not usable as a solid (see lamina check {})",

@@ -72,6 +72,8 @@ class PlanFailures : public ::testing::Test {
         {"a deviation step too fine", knob + " --deviation-step 1e-7 --out {out}", 2},
         {"a bad stock list", knob + " --stock 1,,2 --out {out}", 2},
         {"a rack no layer fits", knob + " --stock-file " + quoted(root_ / "tiny-rack.toml") + " --out {out}", 1},
+        {"a missing deviation reference", knob + " --deviation-against " + quoted(root_ / "nope.step") + " --out {out}", 1},
+        {"an empty deviation reference", knob + " --deviation-against " + quoted(root_ / "empty.stl") + " --out {out}", 1},
     };
   }
 
@@ -85,6 +87,8 @@ TEST_F(PlanFailures, AFolderThatWasNotThereIsNotCreated) {
     const CliRun r = lamina("plan " + with_out(c.args, out));
     EXPECT_EQ(r.exit_code, c.exit_code) << r.out;
     EXPECT_FALSE(r.out.empty()) << "a failed run says why";
+    if (c.what.find("deviation reference") != std::string::npos)
+      EXPECT_NE(r.out.find("the deviation's reference"), std::string::npos) << r.out;
     EXPECT_FALSE(fs::exists(root_ / "new")) << "the failed run created --out or its parent:\n" << r.out;
   }
 }
