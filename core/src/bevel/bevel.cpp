@@ -5,6 +5,7 @@
 
 #include "bevel/bevel_distance.hpp"
 #include "bevel/bevel_gouge.hpp"
+#include "bevel/facets_by_z.hpp"
 #include "geometry/clipper_bridge.hpp"
 #include "lamina/core/section_lines.hpp"
 #include "lamina/core/slice.hpp"
@@ -48,7 +49,8 @@ struct OutlineRing {
 // facet's part inside the layer is projected onto the layer's outline; facets whose clipped
 // corners all sit inside a neighbouring sub-slice add nothing and are skipped (the common case
 // on smooth surfaces, and what keeps this cheap).
-ClipperLib::Paths facet_shadows(const Mesh& mesh, const std::vector<double>& zs, const std::vector<SectionLines>& sections) {
+ClipperLib::Paths facet_shadows(const Mesh& mesh, const std::vector<std::uint32_t>& slab_facets, const std::vector<double>& zs,
+                                const std::vector<SectionLines>& sections) {
   ClipperLib::Paths shadows;
   // Between the outer sub-slices, which are read just inside the faces: a flat face of the
   // model lying on a layer face belongs to the neighbouring layer.
@@ -61,14 +63,21 @@ ClipperLib::Paths facet_shadows(const Mesh& mesh, const std::vector<double>& zs,
     const Eigen::Vector2d p = v.head<2>();
     return sections[lo].contains(p) || sections[hi].contains(p);
   };
-  for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
+  // A vertex is a corner of about six facets: its answer is kept (0 unknown, 1 outside, 2 inside).
+  std::vector<std::uint8_t> vertex_inside(mesh.vertices.size(), 0);
+  auto vertex_inside_neighbour = [&](std::int32_t v) {
+    std::uint8_t& known = vertex_inside[static_cast<std::size_t>(v)];
+    if (known == 0) known = inside_neighbour(mesh.vertices[static_cast<std::size_t>(v)]) ? 2 : 1;
+    return known == 2;
+  };
+  for (const std::uint32_t f : slab_facets) {  // the facets whose z range meets [zb, zt]
     if (std::abs(mesh.normals[f].z()) < 0.02) continue;  // a wall: its shadow is a line
     const auto& tri = mesh.faces[f];
     const Eigen::Vector3d& a = mesh.vertices[static_cast<std::size_t>(tri[0])];
     const Eigen::Vector3d& b = mesh.vertices[static_cast<std::size_t>(tri[1])];
     const Eigen::Vector3d& c = mesh.vertices[static_cast<std::size_t>(tri[2])];
     const double lo = std::min({a.z(), b.z(), c.z()}), hi = std::max({a.z(), b.z(), c.z()});
-    if (hi < zb || lo > zt) continue;
+    const bool unclipped = lo >= zb && hi <= zt;  // its corners are the mesh's vertices
     // Clip to zb ≤ z ≤ zt (Sutherland–Hodgman on the two planes).
     poly.assign({a, b, c});
     for (int side = 0; side < 2 && !poly.empty(); ++side) {
@@ -90,7 +99,8 @@ ClipperLib::Paths facet_shadows(const Mesh& mesh, const std::vector<double>& zs,
     Eigen::Vector3d centre = Eigen::Vector3d::Zero();
     for (std::size_t i = 0; i < poly.size() && all_inside; ++i) {
       centre += poly[i];
-      all_inside = inside_neighbour(poly[i]) && inside_neighbour(0.5 * (poly[i] + poly[(i + 1) % poly.size()]));
+      const bool corner = unclipped ? vertex_inside_neighbour(tri[i]) : inside_neighbour(poly[i]);
+      all_inside = corner && inside_neighbour(0.5 * (poly[i] + poly[(i + 1) % poly.size()]));
     }
     all_inside = all_inside && inside_neighbour(centre / static_cast<double>(poly.size()));
     if (all_inside) continue;
@@ -107,13 +117,13 @@ ClipperLib::Paths facet_shadows(const Mesh& mesh, const std::vector<double>& zs,
 // on the sub-slices.
 class SlabFacets {
  public:
-  SlabFacets(const Mesh& mesh, double zb, double zt, double cell_mm) : mesh_(mesh), zb_(zb), zt_(zt) {
+  // `slab_facets`: the facets whose z range meets [zb, zt], ascending.
+  SlabFacets(const Mesh& mesh, const std::vector<std::uint32_t>& slab_facets, double zb, double zt, double cell_mm)
+      : mesh_(mesh), zb_(zb), zt_(zt), facets_(slab_facets) {
     std::vector<Box2> footprints;
-    for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
+    footprints.reserve(facets_.size());
+    for (const std::uint32_t f : facets_) {
       const auto [a, b, c] = corners(f);
-      const double zl = std::min({a.z(), b.z(), c.z()}), zh = std::max({a.z(), b.z(), c.z()});
-      if (zh < zb || zl > zt) continue;
-      facets_.push_back(static_cast<std::uint32_t>(f));
       footprints.push_back({a.head<2>().cwiseMin(b.head<2>()).cwiseMin(c.head<2>()),
                             a.head<2>().cwiseMax(b.head<2>()).cwiseMax(c.head<2>())});
     }
@@ -455,8 +465,8 @@ LayerOutline plan_outline(const OutlineRing& ring, StationContext& cx, LayerPlan
   return outline;
 }
 
-LayerPlan plan_layer(const Mesh& mesh, const LayerSpan& span, int index, const std::vector<double>& zs,
-                     const std::vector<const Slice*>& sub_slices, const BevelParams& params) {
+LayerPlan plan_layer(const Mesh& mesh, const bevel_detail::FacetsByZ& facets_by_z, const LayerSpan& span, int index,
+                     const std::vector<double>& zs, const std::vector<const Slice*>& sub_slices, const BevelParams& params) {
   LayerPlan plan;
   plan.index = index;
   plan.z_bottom_mm = span.z_bottom_mm;
@@ -471,8 +481,10 @@ LayerPlan plan_layer(const Mesh& mesh, const LayerSpan& span, int index, const s
   // turned (nearly) horizontal: the sample counts as absent and the profile gets a ledge.
   const double tan_max = std::tan(std::min(params.fit.tilt_max_rad, 1.5));
   const double reach = span.thickness_mm * std::max(tan_max, 1.0) + 2.0 * params.sub_slice_mm;
-  const SlabFacets slab(mesh, zs.front(), zs.back(), params.station_spacing_mm);
-  const auto rings = layer_outline_rings(sub_slices, facet_shadows(mesh, zs, lines), params.min_hole_width_mm);
+  std::vector<std::uint32_t> slab_facets;
+  facets_by_z.in_slab(zs.front(), zs.back(), slab_facets);
+  const SlabFacets slab(mesh, slab_facets, zs.front(), zs.back(), params.station_spacing_mm);
+  const auto rings = layer_outline_rings(sub_slices, facet_shadows(mesh, slab_facets, zs, lines), params.min_hole_width_mm);
   const SectionLines outline_lines(mesh, outline_section(rings));
   StationContext cx{lines, slab, outline_lines, zs, span.z_bottom_mm, span.z_top_mm(), reach, params,
                     std::vector<ProfileSample>(zs.size()), {}, {}};
@@ -541,11 +553,12 @@ std::expected<BevelPlan, Error> bevel_detail::plan_bevels_on(const Mesh& mesh, c
   double model_z_lo = std::numeric_limits<double>::infinity(), model_z_hi = -model_z_lo;
   if (model)
     for (const Eigen::Vector3d& v : mesh.vertices) model_z_lo = std::min(model_z_lo, v.z()), model_z_hi = std::max(model_z_hi, v.z());
+  const bevel_detail::FacetsByZ facets_by_z(mesh, params.sub_slice_mm);
   auto one = [&](std::size_t i) {
     std::vector<const Slice*> subs;
     for (std::size_t k = first[i]; k < first[i + 1]; ++k) subs.push_back(&(*slices)[k]);
     LayerPlan& layer = plan.layers[i];
-    layer = plan_layer(mesh, layers[i], static_cast<int>(i), layer_z[i], subs, params);
+    layer = plan_layer(mesh, facets_by_z, layers[i], static_cast<int>(i), layer_z[i], subs, params);
     layer.profile_deviation_mm = layer.max_deviation_mm;
     if (!model) return;
     // What the tolerance checks is the 3-D distance (issue 17, item 4): a station's plane can

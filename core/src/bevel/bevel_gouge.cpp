@@ -3,6 +3,7 @@
 
 #include "geometry/clipper_bridge.hpp"
 #include "geometry/stack_geometry.hpp"
+#include "lamina/core/box_grid.hpp"
 
 #include <polyclipping/clipper.hpp>
 
@@ -66,20 +67,65 @@ double distance_to(const Eigen::Vector2d& q, const Chord& c) {
   return (c.pa + s * d - q).norm();
 }
 
-const Chord* nearest_chord(const Eigen::Vector2d& q, const std::vector<Chord>& chords, double& best) {
-  const Chord* nearest = nullptr;
-  best = std::numeric_limits<double>::infinity();
-  for (const Chord& c : chords) {
-    const Eigen::Vector2d gap = (c.lo - q).cwiseMax(q - c.hi).cwiseMax(0.0);
-    if (gap.norm() >= best) continue;
-    const double d = distance_to(q, c);
-    if (d < best) {
-      best = d;
-      nearest = &c;
+// The chords of one height bucketed on a grid, so that a point's nearest chord is found among
+// the cells around it (a ring of cells at a time, until no unvisited cell can hold a nearer one)
+// instead of among every chord of the layer: the sphere's outlines have thousands of chords, and
+// every vertex of every sliver of material outside them asks.
+class ChordIndex {
+ public:
+  explicit ChordIndex(std::vector<Chord> chords) : chords_(std::move(chords)) {
+    std::vector<Box2> boxes;
+    boxes.reserve(chords_.size());
+    for (const Chord& c : chords_) boxes.push_back({c.lo, c.hi});
+    grid_ = BoxGrid(boxes, [](const Eigen::Vector2d& size, std::size_t count) {
+      return std::max(std::sqrt(size.x() * size.y() / static_cast<double>(count)), std::max(size.x(), size.y()) / 1024.0);
+    });
+  }
+
+  // The nearest chord and its distance; of equal distances the first in chord order, as a scan
+  // of every chord would give.
+  const Chord* nearest(const Eigen::Vector2d& q, double& best) const {
+    best = std::numeric_limits<double>::infinity();
+    if (grid_.empty()) return nullptr;
+    std::size_t best_index = chords_.size();
+    const int cx = grid_.column(q.x()), cy = grid_.row(q.y());
+    const double cell = grid_.cell_mm();
+    const int rings = std::max({cx, cy, grid_.nx() - 1 - cx, grid_.ny() - 1 - cy});
+    for (int r = 0; r <= rings; ++r) {
+      for (int y = cy - r; y <= cy + r; ++y) {
+        if (y < 0 || y >= grid_.ny()) continue;
+        const bool edge_row = y == cy - r || y == cy + r;
+        for (int x = cx - r; x <= cx + r; x += (edge_row ? 1 : 2 * r)) {
+          if (x >= 0 && x < grid_.nx()) visit(grid_.cell(x, y), q, best, best_index);
+          if (r == 0) break;
+        }
+      }
+      // Every cell not visited lies outside the block of cells cx±r, cy±r.
+      const Eigen::Vector2d block_lo = grid_.origin() + cell * Eigen::Vector2d(cx - r, cy - r);
+      const Eigen::Vector2d block_hi = grid_.origin() + cell * Eigen::Vector2d(cx + r + 1, cy + r + 1);
+      const double margin = std::min({q.x() - block_lo.x(), block_hi.x() - q.x(), q.y() - block_lo.y(), block_hi.y() - q.y()});
+      if (margin > best) break;
+    }
+    return best_index < chords_.size() ? &chords_[best_index] : nullptr;
+  }
+
+ private:
+  void visit(std::size_t cell, const Eigen::Vector2d& q, double& best, std::size_t& best_index) const {
+    for (const std::uint32_t i : grid_.items(cell)) {
+      const Chord& c = chords_[i];
+      const Eigen::Vector2d gap = (c.lo - q).cwiseMax(q - c.hi).cwiseMax(0.0);
+      if (gap.norm() > best) continue;
+      const double d = distance_to(q, c);
+      if (d < best || (d == best && i < best_index)) {
+        best = d;
+        best_index = i;
+      }
     }
   }
-  return nearest;
-}
+
+  std::vector<Chord> chords_;
+  BoxGrid grid_;
+};
 
 // Finds material of the sub-slices outside the layer's section; for each piece's vertices the
 // chord they lie beyond and how far each of its stations must move out. Returns the deepest.
@@ -94,12 +140,12 @@ double find_gouges(const LayerPlan& layer, const std::vector<const Slice*>& sub_
     ClipperLib::Paths outside;
     c.Execute(ClipperLib::ctDifference, outside, ClipperLib::pftPositive, ClipperLib::pftPositive);
     if (outside.empty()) continue;
-    const std::vector<Chord> chords = chords_at(layer, z);
+    const ChordIndex chords(chords_at(layer, z));
     for (const ClipperLib::Path& piece : outside) {
       if (std::abs(ClipperLib::Area(piece)) < kMinPieceArea * kClipperUnitsPerMm * kClipperUnitsPerMm) continue;
       for (const Eigen::Vector2d& q : from_clipper(piece)) {
         double d = 0.0;
-        const Chord* ch = nearest_chord(q, chords, d);
+        const Chord* ch = chords.nearest(q, d);
         if (!ch || d <= kGougeTolerance) continue;
         // Material lies on the left of every ring's direction: the scrap side is the right.
         const Eigen::Vector2d dir = (ch->pb - ch->pa).normalized();
