@@ -111,6 +111,7 @@ std::map<std::string, Section, std::less<>> sections() {
       {"dialect", choice<PostDialect>(post_dialects(), [](auto& c, PostDialect v) { c.post.dialect = v; })},
       {"linear_decimals", whole(1, 6, [](auto& c, long v) { c.post.linear_decimals = static_cast<int>(v); })},
       {"angular_decimals", whole(1, 6, [](auto& c, long v) { c.post.angular_decimals = static_cast<int>(v); })},
+      {"hold_rotary_within_step", flag([](auto& c, bool v) { c.post.hold_rotary_within_step = v; })},
       {"jet_on", mcode([](auto& c, const std::string& v) { c.post.jet_on = v; })},
       {"jet_off", mcode([](auto& c, const std::string& v) { c.post.jet_off = v; })},
       {"program_number", whole(1, 9999, [](auto& c, long v) { c.post.program_number = static_cast<int>(v); })},

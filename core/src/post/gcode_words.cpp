@@ -27,6 +27,15 @@ std::string format_significant(double value, int significant, int max_decimals, 
   if (magnitude > 0.0 && std::isfinite(magnitude)) {
     const int leading = static_cast<int>(std::floor(std::log10(magnitude))) + 1;  // digits before the point
     decimals = std::clamp(significant - leading, 0, max_decimals);
+    // Fewer decimals still, where the value written stays within the relative error that
+    // `significant` digits promise at worst (half a unit of the last digit of 10^(significant−1)):
+    // 898.9 is written 899 (1e-4 off), 150.4 stays as it is.
+    const double promised = 0.5 * std::pow(10.0, 1 - significant) * magnitude;
+    while (decimals > 0) {
+      const double scale = std::pow(10.0, decimals - 1);
+      if (std::abs(std::round(value * scale) / scale - value) > promised) break;
+      --decimals;
+    }
   }
   return format_number(value, decimals, keep_point);
 }

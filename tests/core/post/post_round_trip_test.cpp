@@ -93,6 +93,41 @@ TEST(PostRoundTrip, SignsOffsetAndPivotOfAnotherHead) {
   }
 }
 
+// A bevel's stations alternate: at a mesh's vertices and between them the tilt differs by a few
+// thousandths of a degree. A pivot post holds A and C while the far face stays within a linear
+// step (here 0.006° on a 6 mm sheet is 0.63 µm), so A is written once along the edge, not on
+// every line; X Y Z follow the angle held, so the tip is where planned. Off, A alternates.
+TEST(PostRoundTrip, APivotPostHoldsARotaryWordWhileTheFarFaceStaysWithinAStep) {
+  ContourSpec edge;
+  for (int k = 0; k <= 200; ++k) {
+    const double tilt = (20.0 + (k % 2 ? 0.006 : 0.0)) * deg;
+    edge.stations.push_back({{100.0 + 0.5 * k, 100.0, 0.0}, tilted(tilt, -std::numbers::pi / 2)});
+  }
+  const SheetToolpath tp = make_toolpath({edge});
+  ASSERT_DOUBLE_EQ(tp.thickness_mm, 6.0);
+  HeadKinematics head;
+  head.rtcp = false;
+  PostParams params;
+  params.dialect = PostDialect::grblhal;
+  params.angular_decimals = 3;
+  auto a_words = [](const std::string& text) {
+    std::size_t n = 0;
+    for (const std::string& line : split_lines(text))
+      if (line.find('A') != std::string::npos && line.front() != '(') ++n;
+    return n;
+  };
+  const RoundTrip held = round_trip(tp, head, params);  // tip within 1 µm, far face within 1 µm
+  params.hold_rotary_within_step = false;
+  const RoundTrip every = round_trip(tp, head, params);
+  ASSERT_GT(every.posted.five_axis_moves, 150u);
+  EXPECT_GT(a_words(every.posted.text), 190u);
+  EXPECT_LT(a_words(held.posted.text), 12u);  // the rapids and the lead-in turn, then one A
+  std::printf("alternating bevel, grblhal pivot: %zu bytes held, %zu written every time\n", held.posted.text.size(),
+              every.posted.text.size());
+  // Each of the ~200 lines loses its A word and the Z that A moved.
+  EXPECT_LT(held.posted.text.size() + 200 * 8, every.posted.text.size());
+}
+
 TEST(PostRoundTrip, CompactTypicalCutWithRtcpIsUnder30BytesPerFiveAxisMove) {
   // A bevelled outline: a cone of 1 mm segments at 25° tilt, tip on the top face.
   HeadKinematics head;

@@ -29,6 +29,11 @@ struct PostParams {
   PostDialect dialect = PostDialect::grblhal;
   int linear_decimals = 3;   // mm
   int angular_decimals = 4;  // degrees (4: 1e-4° on a 150 mm pivot is 0.26 µm at the tip)
+  // Without RTCP: A and C are not rewritten while the axis they give stays within one linear step
+  // of the planned one at the sheet's far face (thickness times the angle between them), and are
+  // written with the fewest decimals that keep it there; X Y Z follow the angles written, so the
+  // tip does not move. Off: every change that shows in angular_decimals is written.
+  bool hold_rotary_within_step = true;
   int feed_decimals = 1;     // most decimals of a G94 F (mm/min); both F kinds get 4 significant digits
   std::string jet_on = "M3";   // M-code(s) that open the cutting-head valve
   std::string jet_off = "M5";
