@@ -144,27 +144,37 @@ TEST(SimFaults, PressureDropAtTimeTakesThePumpOutOfReady) {
 
 // Pump and jet consent on, a heartbeat every 50 ms for 0.5 s: the pump comes to pressure and the
 // valve opens. The heartbeat then falls silent.
-void open_the_jet(PlcClient& plc) {
-  ASSERT_EQ(modbus_write_bit(plc.ctx, 0, 1), 1);  // pump_enable
-  ASSERT_EQ(modbus_write_bit(plc.ctx, 2, 1), 1);  // jet_on
+// The PLC's watchdog in these tests: long enough that a loaded machine's scheduling stalls
+// (hundreds of ms seen beside a build) never starve a heartbeat sent every 50 ms, so the jet
+// goes off only when the test falls silent on purpose. The exact timing of the watchdog is
+// checked with time as an argument (Plc.HeartbeatTimeoutLatchesAndResetNeedsHeartbeatsBack).
+constexpr int kWatchdogMs = 1000;
+
+// Opens the jet with a live heartbeat; returns the time just before the last heartbeat was sent:
+// the PLC cannot have seen it earlier, so its watchdog cannot trip before this + kWatchdogMs.
+std::chrono::steady_clock::time_point open_the_jet(PlcClient& plc) {
+  std::chrono::steady_clock::time_point last_beat{};
+  EXPECT_EQ(modbus_write_bit(plc.ctx, 0, 1), 1);  // pump_enable
+  EXPECT_EQ(modbus_write_bit(plc.ctx, 2, 1), 1);  // jet_on
   for (uint16_t beat = 1; beat <= 10; ++beat) {
-    ASSERT_EQ(modbus_write_register(plc.ctx, 1, beat), 1);
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    if (beat > 1) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    last_beat = std::chrono::steady_clock::now();
+    EXPECT_EQ(modbus_write_register(plc.ctx, 1, beat), 1);
   }
-  ASSERT_EQ(plc.input_bit(3), 1) << "jet_is_on while the heartbeat is alive";
+  EXPECT_EQ(plc.input_bit(3), 1) << "jet_is_on while the heartbeat is alive";
+  return last_beat;
 }
 
 TEST(SimFaults, SilentHeartbeatTurnsTheJetOffAndLatchesAnAlarm) {
-  FaultSim s({"--modbus", "127.0.0.1:0", "--pressure-ramp", "0.1", "--heartbeat-timeout", "300"});
+  FaultSim s({"--modbus", "127.0.0.1:0", "--pressure-ramp", "0.1", "--heartbeat-timeout", std::to_string(kWatchdogMs)});
   PlcClient plc(s.sim.modbus_port());
-  ASSERT_NO_FATAL_FAILURE(open_the_jet(plc));
+  const auto last_beat = open_the_jet(plc);
+  ASSERT_FALSE(::testing::Test::HasFailure());
   EXPECT_GE(plc.input_register(3), 10) << "heartbeat_seen";
-  const auto silent = std::chrono::steady_clock::now();
-  while (plc.input_bit(3) == 1 && seconds_since(silent) < 2) std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  const double off_after_s = seconds_since(silent);
-  EXPECT_EQ(plc.input_bit(3), 0);
-  EXPECT_GT(off_after_s, 0.25) << "not before the 300 ms timeout";
-  EXPECT_LT(off_after_s, 0.6) << "soon after it";
+  // Bounded wait for the event; the jet goes off by itself, with nothing more sent.
+  while (plc.input_bit(3) == 1 && seconds_since(last_beat) < 10) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  EXPECT_EQ(plc.input_bit(3), 0) << "the jet is still on " << seconds_since(last_beat) << " s after the last heartbeat";
+  EXPECT_GE(seconds_since(last_beat), kWatchdogMs / 1000.0) << "not before the watchdog's timeout";
   EXPECT_EQ(plc.input_bit(4), 1) << "alarm_latched";
   EXPECT_EQ(plc.input_register(6), 2) << "alarm_code heartbeat";
 }
@@ -172,9 +182,10 @@ TEST(SimFaults, SilentHeartbeatTurnsTheJetOffAndLatchesAnAlarm) {
 // `plc down`: the PLC off the network. Its connections drop, a new one is never answered, and
 // its watchdog runs on: the host's silence trips it. `plc up` serves again, the alarm latched.
 TEST(SimFaults, PlcDownAnswersNothingAndItsWatchdogRunsOn) {
-  FaultSim s({"--modbus", "127.0.0.1:0", "--pressure-ramp", "0.1", "--heartbeat-timeout", "300"});
+  FaultSim s({"--modbus", "127.0.0.1:0", "--pressure-ramp", "0.1", "--heartbeat-timeout", std::to_string(kWatchdogMs)});
   PlcClient plc(s.sim.modbus_port());
-  ASSERT_NO_FATAL_FAILURE(open_the_jet(plc));
+  const auto last_beat = open_the_jet(plc);
+  ASSERT_FALSE(::testing::Test::HasFailure());
   EXPECT_EQ(control(s.sim.control_port(), "plc down"), "ok");
   EXPECT_EQ(plc.input_bit(3), -1) << "the old connection is gone";
   {
@@ -187,7 +198,8 @@ TEST(SimFaults, PlcDownAnswersNothingAndItsWatchdogRunsOn) {
     modbus_close(late);
     modbus_free(late);
   }
-  std::this_thread::sleep_for(std::chrono::milliseconds(400));  // past the watchdog
+  // Past the watchdog (nobody can reach the PLC, so nothing else can be waited for).
+  while (seconds_since(last_beat) < kWatchdogMs / 1000.0 + 0.2) std::this_thread::sleep_for(std::chrono::milliseconds(20));
   EXPECT_EQ(control(s.sim.control_port(), "plc up"), "ok");
   PlcClient back(s.sim.modbus_port());
   EXPECT_EQ(back.input_bit(3), 0) << "the watchdog closed the jet while nobody could reach the PLC";

@@ -70,7 +70,9 @@ class FacetsByZ {
 
  private:
   std::int64_t bin_of(double z) const {
-    return std::clamp(static_cast<std::int64_t>(std::floor((z - z0_) / bin_mm_)), std::int64_t{0}, bins_ - 1);
+    // Clamped as a double first: a height far outside the mesh must not overflow the cast.
+    const double b = std::clamp(std::floor((z - z0_) / bin_mm_), 0.0, static_cast<double>(bins_ - 1));
+    return static_cast<std::int64_t>(b);
   }
 
   std::vector<double> lo_, hi_;  // per facet, as the scans compared them

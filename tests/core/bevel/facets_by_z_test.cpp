@@ -61,6 +61,18 @@ TEST(FacetsByZ, GivesWhatAScanOfEveryFacetGivesInItsOrder) {
   expect_same_as_scan(random_triangles(5000, 100.0, 0, 1), 0.5, 100.0);
 }
 
+TEST(FacetsByZ, SlabsFarFromTheMeshHoldNoFacet) {
+  const Mesh m = random_triangles(500, 100.0, 0, 3);
+  const FacetsByZ index(m, 0.5);
+  std::vector<std::uint32_t> got;
+  index.in_slab(-1e15, -1e14, got);
+  EXPECT_TRUE(got.empty());
+  index.in_slab(1e14, 1e15, got);
+  EXPECT_TRUE(got.empty());
+  index.in_slab(-1e15, 1e15, got);
+  EXPECT_EQ(got.size(), m.faces.size());
+}
+
 TEST(FacetsByZ, FullHeightStripsMakeTheBinsCoarserAndChangeNothing) {
   // Every other facet spans the whole height: listed in each of 200 bins, that would be 100
   // entries per facet; the index coarsens its bins instead.
