@@ -3,7 +3,7 @@
 #include "lamina/core/elapsed.hpp"
 #include "lamina/core/mesh_io.hpp"
 #if LAMINA_HAVE_STEP
-#include "lamina/step/cad_reader.hpp"
+#include "step_plugin_loader.hpp"
 #endif
 #include "lamina/core/slice.hpp"
 
@@ -37,7 +37,7 @@ std::expected<TriangleSoup, Error> read_cad(const ModelOptions& options) {
   CadReadOptions cad;
   cad.quote_file_text = !options.no_quote_input;
   if (options.chord_tolerance_mm) cad.chord_tolerance_mm = *options.chord_tolerance_mm;
-  return read_cad_file(options.path, cad);
+  return read_cad_file_via_plugin(options.path, cad);
 #else
   return std::unexpected(Error{ErrorCode::unsupported,
                                fmt::format("{}: this lamina was built without STEP support (OpenCASCADE was not found "

@@ -17,8 +17,9 @@ struct CliRun {
 };
 
 // `redirect` is appended to the command line: "2>&1" merges stderr, "2>/dev/null" drops it.
-inline CliRun run_lamina(const std::string& args, const char* redirect) {
-  const std::string cmd = std::string(LAMINA_CLI) + " " + args + " " + redirect;
+// `env`: NAME=value assignments (no spaces) put before the program, for it alone.
+inline CliRun run_lamina(const std::string& args, const char* redirect, const std::string& env = "") {
+  const std::string cmd = env + (env.empty() ? "" : " ") + std::string(LAMINA_CLI) + " " + args + " " + redirect;
   CliRun r;
   FILE* p = ::popen(cmd.c_str(), "r");
   if (!p) return r;
@@ -31,6 +32,7 @@ inline CliRun run_lamina(const std::string& args, const char* redirect) {
 }
 
 inline CliRun lamina(const std::string& args) { return run_lamina(args, "2>&1"); }
+inline CliRun lamina_with_env(const std::string& env, const std::string& args) { return run_lamina(args, "2>&1", env); }
 inline CliRun lamina_stdout(const std::string& args) { return run_lamina(args, "2>/dev/null"); }
 
 inline std::string quoted(const fs::path& p) { return "'" + p.string() + "'"; }

@@ -116,6 +116,48 @@ TEST(CliStep, TheKnobAsStepPlansTheSameLayersAsItsStlAndNoWorse) {
   EXPECT_LE(step_pct, stl_pct);
 }
 
+#ifdef LAMINA_STEP_MODULE
+// OpenCASCADE is opened only for a CAD file: `lamina` itself needs none of its libraries (its
+// 80 libraries cost 0.1 s at every start when they were linked in), the module does.
+std::string needed_libraries(const std::string& elf) {
+  std::string out;
+  FILE* p = ::popen(("readelf -d " + quoted(fs::path(elf)) + " 2>&1").c_str(), "r");
+  if (!p) return out;
+  std::array<char, 4096> buf{};
+  std::size_t n;
+  while ((n = std::fread(buf.data(), 1, buf.size(), p)) > 0) out.append(buf.data(), n);
+  ::pclose(p);
+  return out;
+}
+
+TEST(CliStep, TheProgramLoadsOpenCascadeOnlyThroughItsStepModule) {
+  const std::string program = needed_libraries(LAMINA_CLI), module = needed_libraries(LAMINA_STEP_MODULE);
+  ASSERT_NE(program.find("NEEDED"), std::string::npos) << program;
+  EXPECT_EQ(program.find("libTK"), std::string::npos) << program;
+  EXPECT_NE(module.find("libTKXDESTEP"), std::string::npos) << module;
+  // Where the program looks for it is where the build put it.
+  const auto r = lamina("check " + quoted(fs::path(LAMINA_EXAMPLES_DIR) / "knob.step"));
+  EXPECT_EQ(r.exit_code, 0) << r.out;
+}
+
+TEST(CliStep, AMissingStepModuleIsNamed) {
+  const auto r = lamina_with_env("LAMINA_STEP_PLUGIN=/nonexistent/liblamina_step.so",
+                                 "check " + quoted(fs::path(LAMINA_EXAMPLES_DIR) / "knob.step"));
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.out.find("the STEP/IGES reader /nonexistent/liblamina_step.so cannot be loaded"), std::string::npos) << r.out;
+  const auto stl = lamina_with_env("LAMINA_STEP_PLUGIN=/nonexistent/liblamina_step.so",
+                                   "check " + quoted(fs::path(LAMINA_EXAMPLES_DIR) / "knob.stl"));
+  EXPECT_EQ(stl.exit_code, 0) << "an STL never needs it: " << stl.out;
+}
+
+TEST(CliStep, AModuleFromAnotherBuildIsRefused) {
+  const auto r = lamina_with_env(std::string("LAMINA_STEP_PLUGIN=") + LAMINA_OTHER_BUILD_STEP_MODULE,
+                                 "check " + quoted(fs::path(LAMINA_EXAMPLES_DIR) / "knob.step"));
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.out.find("is from another build ('lamina-step 0.0.0"), std::string::npos) << r.out;
+}
+#endif
+
 TEST(CliStep, WithoutSupportSaysSo) {
   if (reads_step()) GTEST_SKIP() << "this build reads STEP (covered by CliStepModels)";
   const auto r = lamina("check " + quoted(shared_model("step_cube_cylinder.step")));

@@ -31,6 +31,13 @@ if [[ -f "$build/web/index.html" ]]; then
     grep -qx "$f" "$work/files" || fail "$f is not in the package"
   done
 fi
+# The STEP module, when this build made it (core/step): packaged beside the programs' bin/, where
+# the packaged lamina looks for it (checked below by reading a STEP file with it).
+step_module=false
+if [[ -f "$build/lib/lamina/liblamina_step.so" ]]; then
+  step_module=true
+  grep -qx ./usr/lib/lamina/liblamina_step.so "$work/files" || fail "./usr/lib/lamina/liblamina_step.so is not in the package"
+fi
 dpkg-deb -e "$deb" "$work/control"
 grep -qx /etc/lamina/lamina.toml "$work/control/conffiles" || fail "/etc/lamina/lamina.toml is not a conffile"
 for s in postinst prerm postrm; do [[ -x "$work/control/$s" ]] || fail "$s is missing or not executable"; done
@@ -43,4 +50,9 @@ out=$("$work/root/usr/sbin/laminad" --version)
 [[ $out == "laminad $version" ]] || fail "laminad --version says '$out'"
 "$work/root/usr/sbin/laminad" --check-config --config "$work/root/etc/lamina/lamina.toml" \
   || fail "the packaged configuration does not pass laminad --check-config"
+if $step_module; then
+  knob=$(cd "$(dirname "$0")/../../examples" && pwd)/knob.step
+  "$work/root/usr/bin/lamina" check "$knob" >"$work/step.log" 2>&1 \
+    || { cat "$work/step.log"; fail "the packaged lamina cannot read $knob through its STEP module"; }
+fi
 echo "ok: $(basename "$deb"), $(du -h "$deb" | cut -f1), $(wc -l <"$work/files") entries"
