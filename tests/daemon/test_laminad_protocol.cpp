@@ -15,6 +15,7 @@
 #include <thread>
 
 #include "daemon_fixture.hpp"
+#include "http_test_client.hpp"
 
 namespace lamina::daemon::testing {
 namespace {
@@ -174,7 +175,7 @@ TEST(LaminadProtocol, ABadSettingLeavesTheUploadForTheNextTry) {
 
 TEST(LaminadProtocol, TcpNeedsTheToken) {
   Cell cell;
-  const int port = 20000 + (::getpid() % 20000);
+  const int port = free_loopback_port();
   Laminad daemon(cell.config(fmt::format("tcp = \"127.0.0.1:{}\"\ntoken = \"s3cret-token\"", port)), cell.dir.file(""));
   (void)connect(cell.socket());  // up
   // Without a token (our client refuses to send none: a raw socket does).
@@ -208,7 +209,7 @@ TEST(LaminadProtocol, TcpNeedsTheToken) {
 // bench/hold_under_attack.sh).
 TEST(LaminadProtocol, TheOperatorsHoldGetsThroughUnderAttack) {
   Cell cell({}, 10);
-  const int port = 20000 + ((::getpid() + 7) % 20000);
+  const int port = free_loopback_port();
   Laminad daemon(cell.config(fmt::format("tcp = \"127.0.0.1:{}\"\ntoken = \"s3cret-token\"", port)), cell.dir.file(""));
   RpcClient c = connect(cell.socket());
   const std::string id = start_cutting(c, cell, 50);

@@ -102,13 +102,15 @@ std::vector<Candidate> unmeasured(const Estimator& est, const LayerChoice& choic
 
 std::expected<LayerChoice, Error> layer_verified(Estimator& est, const Mesh& mesh, const LayeringParams& params) {
   LayerChoice choice = layer_optimal(est, params);
-  std::optional<geometry_detail::TriangleTree> model;  // built once, for every round's plans
+  std::optional<geometry_detail::TriangleTree> own_model;  // built once, for every round's plans, unless given
+  const geometry_detail::TriangleTree* model =
+      params.model_index && params.model_index->indexes(mesh) ? &params.model_index->tree() : nullptr;
   PlanCache plans;
   for (int round = 0; round < kMaxRounds; ++round) {
     if (choice.layers.empty() || choice.state_limit) break;
     const std::vector<Candidate> todo = unmeasured(est, choice);
     if (todo.empty()) break;  // every chosen layer stands on its measure
-    if (!model) model.emplace(mesh.vertices, mesh.faces, geometry_detail::threads_for(params.parallel));
+    if (!model) model = &own_model.emplace(mesh.vertices, mesh.faces, geometry_detail::threads_for(params.parallel));
     auto fresh = measure(est, mesh, *model, params, todo, plans);
     if (!fresh) return std::unexpected(fresh.error());
     if (params.on_round) params.on_round(round + 1, kMaxRounds);

@@ -97,7 +97,14 @@ struct Run {
   PlanJobResult r;
   ReportTiming timing;
   std::vector<std::string> warnings;
+  std::shared_ptr<const ModelDistanceIndex> model_index;  // model_index(): built on first use
 };
+
+// The model's triangle tree, built on first use and shared by the layering and the deviation.
+std::shared_ptr<const ModelDistanceIndex> model_index(Run& run) {
+  if (!run.model_index) run.model_index = std::make_shared<const ModelDistanceIndex>(run.mesh, true);
+  return run.model_index;
+}
 
 // The layers and their cuts, once (no programs).
 std::expected<void, PlanJobError> layers_and_bevels(Run& run, const LayeringParams& params, bool first_round) {
@@ -105,6 +112,7 @@ std::expected<void, PlanJobError> layers_and_bevels(Run& run, const LayeringPara
   LayeringParams p = params;
   p.on_round = [&](int done, int bound) { run.progress.step(PlanPhase::choosing_layers, done, bound); };
   auto t0 = Clock::now();
+  p.model_index = model_index(run);
   auto layering = choose_layers(run.mesh, p);
   run.timing.layering += seconds_since(t0);
   if (!layering) return failed(PlanPhase::choosing_layers, layering.error());
@@ -180,7 +188,9 @@ std::expected<void, PlanJobError> measure_strategies(Run& run) {
       other = std::move(*p);
     }
     const Mesh& reference = run.q.deviation_reference ? *run.q.deviation_reference : run.mesh;
-    auto d = measure_deviation(reference, other ? *other : run.r.plan, deviation_params(settings));
+    DeviationParams dp = deviation_params(settings);
+    if (&reference == &run.mesh) dp.model_index = model_index(run);
+    auto d = measure_deviation(reference, other ? *other : run.r.plan, dp);
     if (!d) return failed(PlanPhase::measuring_deviation, d.error());
     run.r.deviations.push_back({s, *d});
     run.progress.step(PlanPhase::measuring_deviation, static_cast<int>(run.r.deviations.size()),

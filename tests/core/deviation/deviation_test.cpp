@@ -6,6 +6,8 @@
 #include "mesh_soups.hpp"
 #include "shapes.hpp"
 
+#include "lamina/core/model_index.hpp"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -146,6 +148,32 @@ TEST(Deviation, FinerStationsShowTheFacetingOfTheMesh) {
   EXPECT_NEAR(d.volume_mm3, want, 2e-3 * want);
   EXPECT_NEAR(d.volume_pct, 100.0 * want / (regular_polygon_area(seg, r) * h), 1e-3);
   EXPECT_NEAR(d.max_mm, r * (1.0 - std::cos(std::numbers::pi / seg)), 1e-4);
+}
+
+// A whole plan builds the model's triangle tree once and hands it to the deviation: the answer
+// is the one the deviation gets with its own tree, and a tree of another mesh (a STEP plan's
+// finer reference) is not used for this one, even a mesh equal to it.
+TEST(Deviation, AGivenTreeOfTheMeshGivesTheSameAnswerAndAnotherMeshsIsNotUsed) {
+  const double r = 20.0, h = 10.0;
+  const Mesh mesh = mesh_test::build_checked(mesh_test::cylinder(r, h, 64));
+  const Mesh coarse = mesh_test::build_checked(mesh_test::cylinder(r, h, 8));
+  const BevelPlan plan = plan_of({disc_layer(0, 0.0, h, r, 256)});
+  const Deviation own = measure(mesh, plan);
+  DeviationParams given;
+  given.model_index = std::make_shared<const ModelDistanceIndex>(mesh, true);
+  ASSERT_TRUE(given.model_index->indexes(mesh));
+  const Deviation with = measure(mesh, plan, given);
+  EXPECT_EQ(with.max_mm, own.max_mm);
+  EXPECT_EQ(with.max_at_mm, own.max_at_mm);
+  EXPECT_EQ(with.volume_mm3, own.volume_mm3);
+  // The octagon's tree is 20·(1 − cos 22.5°) = 1.52 mm off the 64-gon's wall in places: used by
+  // mistake, it would show.
+  DeviationParams wrong;
+  wrong.model_index = std::make_shared<const ModelDistanceIndex>(coarse, true);
+  EXPECT_FALSE(wrong.model_index->indexes(mesh));
+  EXPECT_EQ(measure(mesh, plan, wrong).max_mm, own.max_mm);
+  const Mesh copy = mesh;
+  EXPECT_FALSE(given.model_index->indexes(copy)) << "another object, even an equal one";
 }
 
 TEST(Deviation, OversizeRingIsTheAnnulus) {

@@ -5,11 +5,13 @@
 #include "lamina/core/bevel.hpp"
 #include "lamina/core/error.hpp"
 #include "lamina/core/mesh.hpp"
+#include "lamina/core/model_index.hpp"
 #include "lamina/core/polygon.hpp"
 
 #include <Eigen/Core>
 
 #include <expected>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -35,6 +37,8 @@ struct DeviationParams {
   double step_mm = 0.1;             // spacing of the sections integrated over z
   double distance_sample_mm = 0.5;  // spacing of the surface points used for the largest distance
   bool parallel = true;
+  // The measured mesh's triangle tree, when the caller has one (ignored for another mesh).
+  std::shared_ptr<const ModelDistanceIndex> model_index;
 };
 
 struct Deviation {

@@ -11,6 +11,7 @@
 #include "lamina/core/bevel_profile.hpp"
 #include "lamina/core/error.hpp"
 #include "lamina/core/mesh.hpp"
+#include "lamina/core/model_index.hpp"
 
 #include <cstdint>
 #include <expected>
@@ -59,6 +60,9 @@ struct LayeringParams {
   // Called after each round of the optimal layering's verification (done rounds of at most
   // bound), on the calling thread: a progress bar's steps.
   std::function<void(int done, int bound)> on_round;
+  // The mesh's triangle tree, when the caller has one (a whole plan builds it once for the
+  // layering and the deviation); the verification builds its own without it.
+  std::shared_ptr<const ModelDistanceIndex> model_index;
 };
 
 struct LayerSpan {
