@@ -560,13 +560,17 @@ std::expected<BevelPlan, Error> bevel_detail::plan_bevels_on(const Mesh& mesh, c
     LayerPlan& layer = plan.layers[i];
     layer = plan_layer(mesh, facets_by_z, layers[i], static_cast<int>(i), layer_z[i], subs, params);
     layer.profile_deviation_mm = layer.max_deviation_mm;
-    if (!model) return;
+    if (!model) {
+      if (params.on_layer) params.on_layer();
+      return;
+    }
     // What the tolerance checks is the 3-D distance (issue 17, item 4): a station's plane can
     // neither see a corner that slides along the outline nor the true (normal) distance to a
     // sloped surface.
     layer.surface_distance_mm = bevel_detail::layer_surface_distance(*model, model_z_lo, model_z_hi, layer, subs, params.distance_sample_mm);
     layer.max_deviation_mm = layer.surface_distance_mm;
     layer.within_tolerance = layer.max_deviation_mm <= params.tolerance_mm;
+    if (params.on_layer) params.on_layer();
   };
   if (params.parallel) {
     tbb::parallel_for(std::size_t{0}, layers.size(), one);

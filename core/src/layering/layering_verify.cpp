@@ -21,6 +21,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <mutex>
 #include <optional>
 
 namespace lamina::layering_detail {
@@ -43,6 +44,24 @@ struct Candidate {
   int thickness_index = 0;
 };
 
+// The layers the verification has planned, for the progress bar: each round adds its own to the
+// total, and every layer planned moves the bar (serialized: the layers plan on several threads).
+class LayerCounter {
+ public:
+  explicit LayerCounter(const std::function<void(int, int)>& report) : report_(report) {}
+  void add_to_total(std::size_t n) { total_ += static_cast<int>(n); }
+  void one_more() {
+    const std::lock_guard lock(mutex_);
+    ++done_;
+    if (report_) report_(done_, std::max(done_, total_));
+  }
+
+ private:
+  const std::function<void(int, int)>& report_;
+  std::mutex mutex_;
+  int done_ = 0, total_ = 0;
+};
+
 // The plans made, by (start in µm, thickness index): the chosen layers' plans are handed on.
 using PlanCache = std::map<std::pair<std::int64_t, int>, LayerPlan>;
 std::pair<std::int64_t, int> plan_key(double z_rel, int thickness_index) {
@@ -52,7 +71,8 @@ std::pair<std::int64_t, int> plan_key(double z_rel, int thickness_index) {
 // Plans the candidates (in batches of layers that do not overlap) and records each measure.
 // Returns how many were new.
 std::expected<int, Error> measure(Estimator& est, const Mesh& mesh, const geometry_detail::TriangleTree& model,
-                                  const LayeringParams& params, std::vector<Candidate> todo, PlanCache& plans) {
+                                  const LayeringParams& params, std::vector<Candidate> todo, PlanCache& plans,
+                                  LayerCounter& counter) {
   const std::vector<double>& t = est.thicknesses();
   std::sort(todo.begin(), todo.end(), [](const Candidate& a, const Candidate& b) { return a.z_rel < b.z_rel; });
   int fresh = 0;
@@ -70,7 +90,9 @@ std::expected<int, Error> measure(Estimator& est, const Mesh& mesh, const geomet
     std::vector<LayerSpan> spans;
     for (const Candidate& c : batch)
       spans.push_back(LayerSpan{est.z_base() + c.z_rel, t[static_cast<std::size_t>(c.thickness_index)]});
-    auto plan = bevel_detail::plan_bevels_on(mesh, &model, spans, bevel_params_of(params));
+    BevelParams bp = bevel_params_of(params);
+    bp.on_layer = [&counter] { counter.one_more(); };
+    auto plan = bevel_detail::plan_bevels_on(mesh, &model, spans, bp);
     if (!plan) return std::unexpected(plan.error());
     for (std::size_t i = 0; i < batch.size(); ++i) {
       const GridSpan span = est.span(batch[i].z_rel, t[static_cast<std::size_t>(batch[i].thickness_index)]);
@@ -106,14 +128,15 @@ std::expected<LayerChoice, Error> layer_verified(Estimator& est, const Mesh& mes
   const geometry_detail::TriangleTree* model =
       params.model_index && params.model_index->indexes(mesh) ? &params.model_index->tree() : nullptr;
   PlanCache plans;
+  LayerCounter counter(params.on_round);
   for (int round = 0; round < kMaxRounds; ++round) {
     if (choice.layers.empty() || choice.state_limit) break;
     const std::vector<Candidate> todo = unmeasured(est, choice);
     if (todo.empty()) break;  // every chosen layer stands on its measure
     if (!model) model = &own_model.emplace(mesh.vertices, mesh.faces, geometry_detail::threads_for(params.parallel));
-    auto fresh = measure(est, mesh, *model, params, todo, plans);
+    counter.add_to_total(todo.size());
+    auto fresh = measure(est, mesh, *model, params, todo, plans, counter);
     if (!fresh) return std::unexpected(fresh.error());
-    if (params.on_round) params.on_round(round + 1, kMaxRounds);
     if (*fresh == 0) break;
     est.restart();
     choice = layer_optimal(est, params);

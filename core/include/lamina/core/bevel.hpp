@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <expected>
 #include <span>
+#include <functional>
 #include <vector>
 
 namespace lamina {
@@ -96,6 +97,9 @@ struct BevelParams {
   bool measure_surface_distance = true;
   double distance_sample_mm = 0.5;
   bool parallel = true;             // layers on several threads (TBB); results do not depend on it
+  // Called once for each layer planned, from the planning threads (it must be safe to call from
+  // several at once): a progress bar's steps.
+  std::function<void()> on_layer;
 };
 
 struct BevelPlan {

@@ -57,9 +57,10 @@ struct LayeringParams {
   double greedy_area_deviation = 0.15;
   double greedy_triangle_area_mm2 = 3.2258;
   bool parallel = true;
-  // Called after each round of the optimal layering's verification (done rounds of at most
-  // bound), on the calling thread: a progress bar's steps.
-  std::function<void(int done, int bound)> on_round;
+  // Called as the optimal layering's verification plans each layer: done layers of the total
+  // asked so far (a round that asks for more layers raises it). From the planning threads, one
+  // call at a time: a progress bar's steps.
+  std::function<void(int done, int total)> on_round;
   // The mesh's triangle tree, when the caller has one (a whole plan builds it once for the
   // layering and the deviation); the verification builds its own without it.
   std::shared_ptr<const ModelDistanceIndex> model_index;
