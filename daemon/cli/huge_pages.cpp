@@ -3,6 +3,8 @@
 #include <unistd.h>
 
 #include <cstdlib>
+#include <filesystem>
+#include <system_error>
 #include <fstream>
 
 namespace lamina::cli {
@@ -36,7 +38,11 @@ void restart_with_huge_pages(int argc, char** argv) {
   const std::string before = in.tunables ? in.tunables : "";
   const bool had = in.tunables != nullptr;
   if (::setenv("GLIBC_TUNABLES", tunables->c_str(), 1) != 0) return;
-  ::execv("/proc/self/exe", argv);
+  // The program's own path, not /proc/self/exe: the process is named after the file it runs
+  // (ps and top would say "exe").
+  std::error_code ec;
+  const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", ec);
+  ::execv(ec ? "/proc/self/exe" : self.c_str(), argv);
   // The restart failed: run as we are, and leave the environment as it was.
   if (had) ::setenv("GLIBC_TUNABLES", before.c_str(), 1); else ::unsetenv("GLIBC_TUNABLES");
 }
