@@ -49,7 +49,10 @@ struct Candidate {
 class LayerCounter {
  public:
   explicit LayerCounter(const std::function<void(int, int)>& report) : report_(report) {}
-  void add_to_total(std::size_t n) { total_ += static_cast<int>(n); }
+  void add_to_total(std::size_t n) {
+    const std::lock_guard lock(mutex_);
+    total_ += static_cast<int>(n);
+  }
   void one_more() {
     const std::lock_guard lock(mutex_);
     ++done_;
