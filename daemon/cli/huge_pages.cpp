@@ -1,10 +1,10 @@
 #include "huge_pages.hpp"
 
+#include "own_path.hpp"
+
 #include <unistd.h>
 
 #include <cstdlib>
-#include <filesystem>
-#include <system_error>
 #include <fstream>
 
 namespace lamina::cli {
@@ -40,9 +40,8 @@ void restart_with_huge_pages(int argc, char** argv) {
   if (::setenv("GLIBC_TUNABLES", tunables->c_str(), 1) != 0) return;
   // The program's own path, not /proc/self/exe: the process is named after the file it runs
   // (ps and top would say "exe").
-  std::error_code ec;
-  const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", ec);
-  ::execv(ec ? "/proc/self/exe" : self.c_str(), argv);
+  const auto self = own_program_path();
+  ::execv(self ? self->c_str() : "/proc/self/exe", argv);
   // The restart failed: run as we are, and leave the environment as it was.
   if (had) ::setenv("GLIBC_TUNABLES", before.c_str(), 1); else ::unsetenv("GLIBC_TUNABLES");
 }

@@ -2,6 +2,8 @@
 // keeps it open for the process's life (OpenCASCADE's singletons must outlive its last use).
 #include "step_plugin_loader.hpp"
 
+#include "own_path.hpp"
+
 #include "lamina/step/step_plugin_abi.hpp"
 
 #include <dlfcn.h>
@@ -11,7 +13,6 @@
 #include <cstring>
 #include <mutex>
 #include <string>
-#include <system_error>
 
 namespace lamina::cli {
 
@@ -39,9 +40,15 @@ Module open_module() {
   }
   const auto abi = reinterpret_cast<AbiFn>(dlsym(handle, "lamina_step_plugin_abi"));
   const auto read = reinterpret_cast<ReadFn>(dlsym(handle, "lamina_step_read_cad_file"));
-  if (!abi || !read) return refuse("is not a Lamina STEP module");
-  if (std::strcmp(abi(), step_plugin_abi()) != 0)
-    return refuse(fmt::format("is from another build ('{}', this program is '{}')", abi(), step_plugin_abi()));
+  if (!abi || !read) {
+    ::dlclose(handle);
+    return refuse("is not a Lamina STEP module");
+  }
+  if (std::strcmp(abi(), step_plugin_abi()) != 0) {
+    const std::string other = abi();
+    ::dlclose(handle);
+    return refuse(fmt::format("is from another build ('{}', this program is '{}')", other, step_plugin_abi()));
+  }
   m.read = read;
   return m;
 }
@@ -50,9 +57,8 @@ Module open_module() {
 
 std::filesystem::path step_plugin_path() {
   if (const char* env = std::getenv("LAMINA_STEP_PLUGIN"); env && *env) return env;
-  std::error_code ec;
-  const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
-  const std::filesystem::path bin = ec ? std::filesystem::current_path() : exe.parent_path();
+  const auto self = own_program_path();
+  const std::filesystem::path bin = self ? self->parent_path() : std::filesystem::current_path();
   return bin.parent_path() / "lib" / "lamina" / "liblamina_step.so";
 }
 

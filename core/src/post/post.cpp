@@ -66,14 +66,17 @@ std::string contour_marker(std::size_t index, const ToolContour& c) {
 std::vector<AxisPose> rounded_poses(const SheetToolpath& toolpath, const HeadKinematics& head, const PostParams& params,
                                     std::vector<AxisPose> poses) {
   if (head.rtcp) return poses;
-  const double step = std::pow(10.0, params.angular_decimals);
-  auto rounded = [&](double rad) { return std::round(rad * deg_per_rad * step) / step / deg_per_rad; };
+  // An angle as the controller reads it when written with `decimals` decimals of a degree.
+  auto rounded = [](double rad, int decimals) {
+    const double scale = std::pow(10.0, decimals);
+    return std::round(rad * deg_per_rad * scale) / scale / deg_per_rad;
+  };
   // A and C are held while the axis they give stays so near the planned one that the cut's far
   // face moves by less than one linear step (the sheet's thickness times the angle between
   // them): a bevel's stations alternate by a hundredth of a degree or less, and rewriting A, C
   // and the X Y Z they move for each of them was a fifth of a pivot program's bytes. The tip
   // still lands where planned: X Y Z are computed from the angles held.
-  const double far_face_mm = 1.0 * std::pow(10.0, -params.linear_decimals);
+  const double far_face_mm = std::pow(10.0, -params.linear_decimals);
   const bool hold = params.hold_rotary_within_step && toolpath.thickness_mm > 0.0;
   std::optional<std::pair<double, double>> held;  // A, C as last written
   auto near_enough = [&](double a, double c, const Eigen::Vector3d& planned) {
@@ -84,11 +87,8 @@ std::vector<AxisPose> rounded_poses(const SheetToolpath& toolpath, const HeadKin
   // error, so a nearly vertical head's C needs none; A moves it one for one. C first, then A.
   auto shortest_within = [&](std::pair<double, double> ac, const Eigen::Vector3d& planned) {
     auto fewest = [&](double rad, auto&& fits) {
-      for (int d = 0; d < params.angular_decimals; ++d) {
-        const double scale = std::pow(10.0, d);
-        const double r = std::round(rad * deg_per_rad * scale) / scale / deg_per_rad;
-        if (fits(r)) return r;
-      }
+      for (int d = 0; d < params.angular_decimals; ++d)
+        if (const double r = rounded(rad, d); fits(r)) return r;
       return rad;
     };
     ac.second = fewest(ac.second, [&](double c) { return near_enough(ac.first, c, planned); });
@@ -97,7 +97,7 @@ std::vector<AxisPose> rounded_poses(const SheetToolpath& toolpath, const HeadKin
   };
   for (std::size_t i = 0; i < poses.size(); ++i) {
     AxisPose& p = poses[i];
-    std::pair<double, double> ac{rounded(p.a_rad), rounded(p.c_rad)};
+    std::pair<double, double> ac{rounded(p.a_rad, params.angular_decimals), rounded(p.c_rad, params.angular_decimals)};
     if (hold && held) {
       // Only a small difference is held: never C a turn away, nor A through zero (the same axis).
       constexpr double kMostHeldRad = 1.0 / deg_per_rad;
