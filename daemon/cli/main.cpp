@@ -1,10 +1,10 @@
 // lamina: the command-line tool. Offline commands work on a model file directly; ports and
 // stream talk to the machine through drivers/.
 #include "commands.hpp"
-#include "huge_pages.hpp"
+#include "malloc_tuning.hpp"
 
 int main(int argc, char** argv) {
-  lamina::cli::restart_with_huge_pages(argc, argv);
+  lamina::cli::restart_with_malloc_tuning(argc, argv);
   CLI::App app{"lamina — laminated parts for 5-axis abrasive waterjets"};
   app.require_subcommand(1);
   int exit_code = 0;
