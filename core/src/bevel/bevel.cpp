@@ -3,7 +3,7 @@
 // normal, the cut lines fitted to that profile, and passes assembled from the lines.
 #include "lamina/core/bevel.hpp"
 
-#include "bevel/bevel_distance.hpp"
+#include "bevel/plan_layers.hpp"
 #include "bevel/bevel_gouge.hpp"
 #include "bevel/facets_by_z.hpp"
 #include "geometry/clipper_bridge.hpp"
@@ -11,8 +11,6 @@
 #include "lamina/core/slice.hpp"
 
 #include <Eigen/Geometry>
-#include <fmt/format.h>
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
@@ -465,8 +463,10 @@ LayerOutline plan_outline(const OutlineRing& ring, StationContext& cx, LayerPlan
   return outline;
 }
 
-LayerPlan plan_layer(const Mesh& mesh, const bevel_detail::FacetsByZ& facets_by_z, const LayerSpan& span, int index,
-                     const std::vector<double>& zs, const std::vector<const Slice*>& sub_slices, const BevelParams& params) {
+}  // namespace
+
+LayerPlan bevel_detail::plan_layer(const Mesh& mesh, const bevel_detail::FacetsByZ& facets_by_z, const LayerSpan& span,
+                                   int index, const std::vector<double>& zs, const std::vector<const Slice*>& sub_slices, const BevelParams& params) {
   LayerPlan plan;
   plan.index = index;
   plan.z_bottom_mm = span.z_bottom_mm;
@@ -500,83 +500,6 @@ LayerPlan plan_layer(const Mesh& mesh, const bevel_detail::FacetsByZ& facets_by_
     plan.gouge_left_mm = g.worst_left_mm;
   }
   plan.within_tolerance = plan.max_deviation_mm <= params.tolerance_mm;
-  return plan;
-}
-
-}  // namespace
-
-std::expected<BevelPlan, Error> plan_bevels(const Mesh& mesh, std::span<const LayerSpan> layers,
-                                            const BevelParams& params) {
-  return bevel_detail::plan_bevels_on(mesh, nullptr, layers, params);
-}
-
-std::expected<BevelPlan, Error> bevel_detail::plan_bevels_on(const Mesh& mesh, const TriangleTree* model_tree,
-                                                       std::span<const LayerSpan> layers, const BevelParams& params) {
-  if (!(params.sub_slice_mm > 0.0) || !std::isfinite(params.sub_slice_mm)) {
-    return std::unexpected(Error{ErrorCode::invalid_argument, fmt::format("sub-slice spacing must be > 0 mm (got {})", params.sub_slice_mm)});
-  }
-  if (!(params.fit.tilt_max_rad >= 0.0) || params.fit.tilt_max_rad >= 0.5 * M_PI) {
-    return std::unexpected(Error{ErrorCode::invalid_argument, fmt::format("tilt limit must be in [0°, 90°) (got {:.3f}°)", params.fit.tilt_max_rad * 180.0 / M_PI)});
-  }
-  std::vector<double> all_z;
-  std::vector<std::size_t> first(layers.size() + 1, 0);
-  std::vector<std::vector<double>> layer_z(layers.size());
-  for (std::size_t i = 0; i < layers.size(); ++i) {
-    const auto& l = layers[i];
-    if (!(l.thickness_mm > 0.0) || !std::isfinite(l.z_bottom_mm)) {
-      return std::unexpected(Error{ErrorCode::invalid_argument, fmt::format("layer {}: thickness must be > 0 mm (got {})", i, l.thickness_mm)});
-    }
-    if (i > 0 && l.z_bottom_mm < layers[i - 1].z_top_mm() - 1e-9) {
-      return std::unexpected(Error{ErrorCode::invalid_argument,
-                                   fmt::format("layer {} starts at z = {} mm, below the top of layer {} ({} mm)", i, l.z_bottom_mm, i - 1, layers[i - 1].z_top_mm())});
-    }
-    layer_z[i] = sub_slice_heights(l.z_bottom_mm, l.thickness_mm, params.sub_slice_mm);
-    first[i] = all_z.size();
-    all_z.insert(all_z.end(), layer_z[i].begin(), layer_z[i].end());
-  }
-  first[layers.size()] = all_z.size();
-  SliceParams slice_params;
-  slice_params.parallel = params.parallel;
-  auto slices = slice_mesh(mesh, all_z, slice_params);
-  if (!slices) return std::unexpected(slices.error());
-
-  BevelPlan plan;
-  plan.fit = params.fit;
-  plan.layers.resize(layers.size());
-  std::optional<geometry_detail::TriangleTree> own_tree;
-  const geometry_detail::TriangleTree* model = model_tree;
-  if (params.measure_surface_distance && !layers.empty() && !model) {
-    own_tree.emplace(mesh.vertices, mesh.faces, geometry_detail::threads_for(params.parallel));
-    model = &*own_tree;
-  }
-  if (!params.measure_surface_distance) model = nullptr;
-  double model_z_lo = std::numeric_limits<double>::infinity(), model_z_hi = -model_z_lo;
-  if (model)
-    for (const Eigen::Vector3d& v : mesh.vertices) model_z_lo = std::min(model_z_lo, v.z()), model_z_hi = std::max(model_z_hi, v.z());
-  const bevel_detail::FacetsByZ facets_by_z(mesh, params.sub_slice_mm);
-  auto one = [&](std::size_t i) {
-    std::vector<const Slice*> subs;
-    for (std::size_t k = first[i]; k < first[i + 1]; ++k) subs.push_back(&(*slices)[k]);
-    LayerPlan& layer = plan.layers[i];
-    layer = plan_layer(mesh, facets_by_z, layers[i], static_cast<int>(i), layer_z[i], subs, params);
-    layer.profile_deviation_mm = layer.max_deviation_mm;
-    if (!model) {
-      if (params.on_layer) params.on_layer();
-      return;
-    }
-    // What the tolerance checks is the 3-D distance (issue 17, item 4): a station's plane can
-    // neither see a corner that slides along the outline nor the true (normal) distance to a
-    // sloped surface.
-    layer.surface_distance_mm = bevel_detail::layer_surface_distance(*model, model_z_lo, model_z_hi, layer, subs, params.distance_sample_mm);
-    layer.max_deviation_mm = layer.surface_distance_mm;
-    layer.within_tolerance = layer.max_deviation_mm <= params.tolerance_mm;
-    if (params.on_layer) params.on_layer();
-  };
-  if (params.parallel) {
-    tbb::parallel_for(std::size_t{0}, layers.size(), one);
-  } else {
-    for (std::size_t i = 0; i < layers.size(); ++i) one(i);
-  }
   return plan;
 }
 

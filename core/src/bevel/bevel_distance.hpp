@@ -5,17 +5,11 @@
 #include "lamina/core/bevel.hpp"
 #include "lamina/core/slice.hpp"
 
-#include <expected>
 #include <span>
 #include <vector>
 
 namespace lamina::bevel_detail {
 using geometry_detail::TriangleTree;
-
-// plan_bevels with the model's triangle tree built by the caller (nullptr: built here when
-// params.measure_surface_distance), for callers that plan many times over one mesh (layering).
-std::expected<BevelPlan, Error> plan_bevels_on(const Mesh& mesh, const TriangleTree* model_tree,
-                                               std::span<const LayerSpan> layers, const BevelParams& params);
 
 // Both ways, on samples `ds_mm` apart: the layer's side walls (wall_samples) to the model's
 // triangles, and the model's contours on the layer's sub-slices (every vertex and points between)

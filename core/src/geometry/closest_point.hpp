@@ -33,7 +33,8 @@ class TriangleTree {
   // Distance from p to the nearest triangle. When a triangle within `enough` is found the search
   // may stop there and return that triangle's distance (≤ enough): callers after a maximum of
   // nearest distances lose nothing by it. `hint` (a triangle of an earlier, nearby query; -1 for
-  // none) is tried first and receives the nearest triangle found.
+  // none) is tried first, with its neighbours in the tree's order, and receives the nearest
+  // triangle found.
   double distance(const Eigen::Vector3d& p, double enough, std::int32_t& hint) const;
 
  private:

@@ -11,11 +11,12 @@
 // report). A round costs one plan_bevels of the chosen layers and a DP over memoized estimates.
 //
 // Estimates that were too pessimistic are corrected too: in every round, at each chosen layer's
-// start that is within tolerance, the next thicker sheet is planned as well (kept out of the DP's way of overlaps by
-// planning the thicker layers in separate, non-overlapping batches).
+// start that is within tolerance, the next thicker sheet is planned as well. The layers of a round
+// overlap, so each is planned on its own (plan_layers_apart: one slicing pass, one pool of tasks,
+// the thickest first; on the 1M sphere 2.2 → 1.7 s against batches of layers that do not overlap).
 #include "layering/layering_internal.hpp"
 
-#include "bevel/bevel_distance.hpp"
+#include "bevel/plan_layers.hpp"
 #include "lamina/core/bevel.hpp"
 
 #include <algorithm>
@@ -71,38 +72,28 @@ std::pair<std::int64_t, int> plan_key(double z_rel, int thickness_index) {
   return {std::llround(z_rel * 1e6), thickness_index};
 }
 
-// Plans the candidates (in batches of layers that do not overlap) and records each measure.
-// Returns how many were new.
-std::expected<int, Error> measure(Estimator& est, const Mesh& mesh, const geometry_detail::TriangleTree& model,
+// Plans the candidates, each on its own (they may overlap: a chosen layer and the thicker sheet
+// at its start), and records each measure in the order of their heights. Returns how many were
+// new.
+std::expected<int, Error> measure(Estimator& est, const Mesh& mesh, const bevel_detail::MeshIndexes& indexes,
                                   const LayeringParams& params, std::vector<Candidate> todo, PlanCache& plans,
                                   LayerCounter& counter) {
   const std::vector<double>& t = est.thicknesses();
+  auto thickness = [&](const Candidate& c) { return t[static_cast<std::size_t>(c.thickness_index)]; };
   std::sort(todo.begin(), todo.end(), [](const Candidate& a, const Candidate& b) { return a.z_rel < b.z_rel; });
+  std::vector<LayerSpan> spans;
+  for (const Candidate& c : todo) spans.push_back(LayerSpan{est.z_base() + c.z_rel, thickness(c)});
+  BevelParams bp = bevel_params_of(params);
+  bp.on_layer = [&counter] { counter.one_more(); };
+  auto planned = bevel_detail::plan_layers_apart(mesh, indexes, spans, bp);
+  if (!planned) return std::unexpected(planned.error());
   int fresh = 0;
-  while (!todo.empty()) {
-    std::vector<Candidate> batch, rest;
-    double free_from = -1e300;  // the top of the batch's last layer
-    for (const Candidate& c : todo) {
-      if (c.z_rel < free_from - 1e-9) {
-        rest.push_back(c);
-        continue;
-      }
-      batch.push_back(c);
-      free_from = c.z_rel + t[static_cast<std::size_t>(c.thickness_index)];
-    }
-    std::vector<LayerSpan> spans;
-    for (const Candidate& c : batch)
-      spans.push_back(LayerSpan{est.z_base() + c.z_rel, t[static_cast<std::size_t>(c.thickness_index)]});
-    BevelParams bp = bevel_params_of(params);
-    bp.on_layer = [&counter] { counter.one_more(); };
-    auto plan = bevel_detail::plan_bevels_on(mesh, &model, spans, bp);
-    if (!plan) return std::unexpected(plan.error());
-    for (std::size_t i = 0; i < batch.size(); ++i) {
-      const GridSpan span = est.span(batch[i].z_rel, t[static_cast<std::size_t>(batch[i].thickness_index)]);
-      fresh += est.set_measured(span, batch[i].thickness_index, plan->layers[i].max_deviation_mm) ? 1 : 0;
-      plans.insert_or_assign(plan_key(batch[i].z_rel, batch[i].thickness_index), std::move(plan->layers[i]));
-    }
-    todo = std::move(rest);
+  for (std::size_t i = 0; i < todo.size(); ++i) {
+    LayerPlan& layer = (*planned)[i];
+    layer.index = 0;  // as a plan of the layer alone
+    const GridSpan span = est.span(todo[i].z_rel, thickness(todo[i]));
+    fresh += est.set_measured(span, todo[i].thickness_index, layer.max_deviation_mm) ? 1 : 0;
+    plans.insert_or_assign(plan_key(todo[i].z_rel, todo[i].thickness_index), std::move(layer));
   }
   return fresh;
 }
@@ -130,6 +121,7 @@ std::expected<LayerChoice, Error> layer_verified(Estimator& est, const Mesh& mes
   std::optional<geometry_detail::TriangleTree> own_model;  // built once, for every round's plans, unless given
   const geometry_detail::TriangleTree* model =
       params.model_index && params.model_index->indexes(mesh) ? &params.model_index->tree() : nullptr;
+  std::optional<bevel_detail::FacetsByZ> facets_by_z;  // built once, for every round's plans
   PlanCache plans;
   LayerCounter counter(params.on_round);
   for (int round = 0; round < kMaxRounds; ++round) {
@@ -137,8 +129,9 @@ std::expected<LayerChoice, Error> layer_verified(Estimator& est, const Mesh& mes
     const std::vector<Candidate> todo = unmeasured(est, choice);
     if (todo.empty()) break;  // every chosen layer stands on its measure
     if (!model) model = &own_model.emplace(mesh.vertices, mesh.faces, geometry_detail::threads_for(params.parallel));
+    if (!facets_by_z) facets_by_z.emplace(mesh, params.sub_slice_mm);
     counter.add_to_total(todo.size());
-    auto fresh = measure(est, mesh, *model, params, todo, plans, counter);
+    auto fresh = measure(est, mesh, {model, &*facets_by_z}, params, todo, plans, counter);
     if (!fresh) return std::unexpected(fresh.error());
     if (*fresh == 0) break;
     est.restart();
