@@ -475,7 +475,7 @@ LayerPlan bevel_detail::plan_layer(const Mesh& mesh, const bevel_detail::FacetsB
 
   std::vector<SectionLines> lines;
   lines.reserve(sub_slices.size());
-  for (const Slice* s : sub_slices) lines.emplace_back(mesh, *s);
+  for (const Slice* s : sub_slices) lines.emplace_back(mesh, *s, SectionQueries::crossings_and_contains);
   // How far in a sample may lie and still be this station's surface: what a line at the tilt
   // limit reaches across the layer, plus a sub-slice of slack. Further in, the surface has
   // turned (nearly) horizontal: the sample counts as absent and the profile gets a ledge.

@@ -5,6 +5,7 @@
 #include "lamina/core/surface_normal.hpp"
 
 #include <algorithm>
+#include <iterator>
 #include <cmath>
 #include <limits>
 #include <span>
@@ -13,6 +14,26 @@ namespace lamina {
 
 namespace {
 double cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a.x() * b.y() - a.y() * b.x(); }
+
+// Whether the path a → b crosses the contour vector c → d. An end of c → d on the path's line
+// counts as lying on its right, and an end of the path on the vector's line as lying on its
+// right: the parity along a path made of such pieces is that of the path moved off those
+// coincidences by an infinitesimal amount (a vertex of a loop on the path is crossed once or
+// not at all, never twice).
+bool path_crosses(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c, const Eigen::Vector2d& d) {
+  const Eigen::Vector2d ab = b - a, cd = d - c;
+  if ((cross(ab, c - a) > 0.0) == (cross(ab, d - a) > 0.0)) return false;
+  return (cross(cd, a - c) > 0.0) != (cross(cd, b - c) > 0.0);
+}
+
+// p on the vector a → b, to rounding (1e-9 of the vector's length).
+bool on_segment(const Eigen::Vector2d& p, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  const Eigen::Vector2d ab = b - a, ap = p - a;
+  const double len2 = ab.squaredNorm();
+  if (std::abs(cross(ab, ap)) > 1e-9 * len2) return false;
+  const double t = ab.dot(ap);
+  return t >= 0.0 && t <= len2;
+}
 }  // namespace
 
 double profile_slope(const Eigen::Vector3d& normal, const Eigen::Vector2d& direction) {
@@ -25,7 +46,7 @@ double profile_slope(const Eigen::Vector3d& normal, const Eigen::Vector2d& direc
   return -nz / nd;
 }
 
-SectionLines::SectionLines(const Mesh& mesh, const Slice& slice) : z_mm_(slice.z_mm) {
+SectionLines::SectionLines(const Mesh& mesh, const Slice& slice, SectionQueries queries) : z_mm_(slice.z_mm) {
   std::size_t n = 0;
   for (const auto& l : slice.loops) n += l.size();
   segments_.reserve(n);
@@ -63,6 +84,43 @@ SectionLines::SectionLines(const Mesh& mesh, const Slice& slice) : z_mm_(slice.z
     const double cell = std::max(std::sqrt(size.x() * size.y() / cells_wanted), std::max(size.x(), size.y()) / 4096.0);
     return std::max(cell, 1e-6);
   });
+  if (queries == SectionQueries::crossings_and_contains) build_inside_grid(boxes);
+}
+
+// Cells about two vectors long (at most 16 cells per vector over the extent), and whether each
+// cell's centre is material: along each row of cells, from left of the grid (outside every loop)
+// through the centres of its cells, each step crossing only vectors listed in the two cells it
+// joins.
+void SectionLines::build_inside_grid(const std::vector<Box2>& boxes) {
+  double length = 0.0;
+  for (const Segment& s : segments_) length += (s.b - s.a).norm();
+  const double mean = length / static_cast<double>(segments_.size());
+  inside_grid_ = BoxGrid(boxes, [mean](const Eigen::Vector2d& size, std::size_t count) {
+    const double most_cells = 16.0 * static_cast<double>(count);
+    return std::max({2.0 * mean, std::sqrt(size.x() * size.y() / most_cells), std::max(size.x(), size.y()) / 4096.0, 1e-6});
+  });
+  const BoxGrid& grid = inside_grid_;
+  const int nx = grid.nx(), ny = grid.ny();
+  centre_inside_.assign(static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny), 0);
+  std::vector<std::uint32_t> both;
+  for (int cy = 0; cy < ny; ++cy) {
+    const double y = grid.origin().y() + (cy + 0.5) * grid.cell_mm();
+    Eigen::Vector2d from(grid.origin().x() - grid.cell_mm(), y);  // left of every vector
+    bool inside = false;
+    std::span<const std::uint32_t> previous;
+    for (int cx = 0; cx < nx; ++cx) {
+      const std::size_t cell = grid.cell(cx, cy);
+      const Eigen::Vector2d to(grid.origin().x() + (cx + 0.5) * grid.cell_mm(), y);
+      const std::span<const std::uint32_t> here = grid.items(cell);
+      both.clear();
+      std::set_union(previous.begin(), previous.end(), here.begin(), here.end(), std::back_inserter(both));
+      for (const std::uint32_t idx : both)
+        if (path_crosses(from, to, segments_[idx].a, segments_[idx].b)) inside = !inside;
+      centre_inside_[cell] = inside ? 1 : 0;
+      from = to;
+      previous = here;
+    }
+  }
 }
 
 namespace {
@@ -185,33 +243,28 @@ std::optional<LineCrossing> SectionLines::exit_crossing(const Eigen::Vector2d& o
 
 bool SectionLines::contains(const Eigen::Vector2d& p) const {
   if (segments_.empty()) return false;
-  const Eigen::Vector2d g = (p - grid_.origin()) / grid_.cell_mm();
-  const int nx = grid_.nx();
-  const int cy = static_cast<int>(std::floor(g.y()));
-  if (cy < 0 || cy >= grid_.ny() || g.x() >= nx || g.x() < 0) return false;
-  const int cx0 = static_cast<int>(std::floor(g.x()));
-  // Count crossings of a horizontal ray from p towards the nearer side of the grid, each
-  // segment once (it may sit in several cells of the row).
-  const bool right = cx0 >= nx / 2;
-  std::uint32_t hits[128];
-  int count = 0;
-  std::vector<std::uint32_t> overflow;
-  const int from = right ? cx0 : 0, to = right ? nx : cx0 + 1;
-  for (int cx = from; cx < to; ++cx) {
-    for (const std::uint32_t idx : grid_.items(grid_.cell(cx, cy))) {
-      const Segment& s = segments_[idx];
-      if ((s.a.y() > p.y()) == (s.b.y() > p.y())) continue;
-      const double x = s.a.x() + (p.y() - s.a.y()) * (s.b.x() - s.a.x()) / (s.b.y() - s.a.y());
-      if ((x > p.x()) != right) continue;
-      bool seen = false;
-      for (int i = 0; i < count && !seen; ++i) seen = hits[i] == idx;
-      if (seen) continue;
-      if (count < 128) hits[count++] = idx; else overflow.push_back(idx);
+  if (inside_grid_.empty()) {  // not built for it: every vector, by a ray to the left of the extent
+    const Eigen::Vector2d far(grid_.origin().x() - grid_.cell_mm(), p.y());
+    bool inside = false;
+    for (const Segment& s : segments_) {
+      if (on_segment(p, s.a, s.b)) return true;
+      if (path_crosses(far, p, s.a, s.b)) inside = !inside;
     }
+    return inside;
   }
-  std::sort(overflow.begin(), overflow.end());
-  const auto extra = std::unique(overflow.begin(), overflow.end()) - overflow.begin();
-  return ((count + extra) % 2) == 1;
+  const BoxGrid& grid = inside_grid_;
+  const Eigen::Vector2d g = (p - grid.origin()) / grid.cell_mm();
+  if (!(g.x() >= 0.0 && g.x() < grid.nx() && g.y() >= 0.0 && g.y() < grid.ny())) return false;
+  const int cx = static_cast<int>(g.x()), cy = static_cast<int>(g.y());
+  const std::size_t cell = grid.cell(cx, cy);
+  const Eigen::Vector2d centre = grid.origin() + Eigen::Vector2d(cx + 0.5, cy + 0.5) * grid.cell_mm();
+  bool inside = centre_inside_[cell] != 0;
+  for (const std::uint32_t idx : grid.items(cell)) {
+    const Segment& s = segments_[idx];
+    if (on_segment(p, s.a, s.b)) return true;  // the section is closed: its boundary is material
+    if (path_crosses(centre, p, s.a, s.b)) inside = !inside;
+  }
+  return inside;
 }
 
 }  // namespace lamina

@@ -227,7 +227,7 @@ std::expected<PlanJobResult, PlanJobError> plan_job(const Mesh& mesh, const Plan
                                                     const PlanProgressFn& progress) {
   const auto t_start = Clock::now();
   if (auto ok = check_against_model(request.settings, mesh); !ok) return failed(PlanPhase::checking, ok.error());
-  Run run{mesh, request, Progress(progress), {}, {}, request.warnings};
+  Run run{mesh, request, Progress(progress), {}, {}, request.warnings, {}};
   if (auto ok = plan_on_rack(run); !ok) return std::unexpected(ok.error());
   if (auto ok = measure_strategies(run); !ok) return std::unexpected(ok.error());
 

@@ -1,6 +1,6 @@
 // SectionLines::exit_crossing, the corresponding-point query the layering and the bevel plan ask
 // millions of times: against a brute force over every contour vector of the slice, for both
-// picks, and the rule for two crossings equally far from u = 0.
+// picks, and the rule for two crossings equally far from u = 0; contains against even-odd.
 #include "lamina/core/section_lines.hpp"
 #include "lamina/core/slice.hpp"
 
@@ -90,6 +90,57 @@ TEST(SectionLines, EveryQueryAnswersAsABruteForceOverTheWholeSlice) {
     }
   }
   EXPECT_GT(found, 2000) << "most random lines cross the section";
+}
+
+// Even-odd over every contour vector of the slice: a horizontal ray to +x.
+bool brute_contains(const Slice& slice, const Eigen::Vector2d& p) {
+  bool inside = false;
+  for (const Loop& l : slice.loops)
+    for (std::size_t i = 0; i < l.size(); ++i) {
+      const Eigen::Vector2d a = l.points[i], b = l.points[(i + 1) % l.size()];
+      if ((a.y() > p.y()) == (b.y() > p.y())) continue;
+      if (a.x() + (p.y() - a.y()) * (b.x() - a.x()) / (b.y() - a.y()) > p.x()) inside = !inside;
+    }
+  return inside;
+}
+
+TEST(SectionLines, ContainsAnswersAsEvenOddOverTheWholeSlice) {
+  // A sphere between two boxes, and a point cloud over and around them; half the points
+  // near the contours, where a cell holds vectors.
+  TriangleSoup soup = mesh_test::append(mesh_test::uv_sphere(20, 64, 32, {0, 0, 0}), mesh_test::box({25, -10, -10}, {45, 10, 10}));
+  soup = mesh_test::append(soup, mesh_test::box({-60, -30, -10}, {-35, 30, 10}));
+  const Mesh m = built(soup);
+  for (const double z : {13.3, 20.0, 29.9}) {
+    const Slice slice = slice_at(m, z);
+    ASSERT_FALSE(slice.loops.empty());
+    const SectionLines lines(m, slice, SectionQueries::crossings_and_contains);
+    const SectionLines without(m, slice);  // contains() over every vector
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> x(-70, 60), y(-40, 40), near(-0.3, 0.3);
+    int inside = 0, outside = 0;
+    for (int q = 0; q < 20000; ++q) {
+      Eigen::Vector2d p(x(rng), y(rng));
+      if (q % 2 == 1) {  // near a vertex of a contour
+        const Loop& l = slice.loops[static_cast<std::size_t>(q) % slice.loops.size()];
+        p = l.points[static_cast<std::size_t>(q / 2) % l.size()] + Eigen::Vector2d(near(rng), near(rng));
+      }
+      const bool want = brute_contains(slice, p);
+      ASSERT_EQ(lines.contains(p), want) << "z " << z << " query " << q << " at " << p.transpose();
+      if (q % 10 == 0) ASSERT_EQ(without.contains(p), want) << "z " << z << " query " << q;
+      (want ? inside : outside) += 1;
+    }
+    EXPECT_GT(inside, 2000);
+    EXPECT_GT(outside, 2000);
+    // The section is closed: a point on a contour vector, or at its corner, is material.
+    for (const Loop& l : slice.loops)
+      for (std::size_t i = 0; i < l.size(); i += 7) {
+        const Eigen::Vector2d a = l.points[i], b = l.points[(i + 1) % l.size()];
+        for (const Eigen::Vector2d& on : {a, Eigen::Vector2d(0.5 * (a + b))}) {
+          ASSERT_TRUE(lines.contains(on)) << "z " << z << " loop vertex " << i;
+          ASSERT_TRUE(without.contains(on)) << "z " << z << " loop vertex " << i;
+        }
+      }
+  }
 }
 
 }  // namespace

@@ -28,10 +28,15 @@ enum class CrossingPick : std::uint8_t {
 
 // A uniform grid over one slice's contour vectors. Cheap to build (linear in the slice size),
 // immutable afterwards, safe to query from several threads.
+// Which queries a SectionLines is built for: contains() has its own, finer grid (a cell of a
+// couple of contour vectors: the crossings' grid holds ~√n vectors in each cell a contour
+// passes), built only when asked for.
+enum class SectionQueries : std::uint8_t { crossings, crossings_and_contains };
+
 class SectionLines {
  public:
   SectionLines() = default;
-  SectionLines(const Mesh& mesh, const Slice& slice);
+  SectionLines(const Mesh& mesh, const Slice& slice, SectionQueries queries = SectionQueries::crossings);
 
   double z_mm() const { return z_mm_; }
   bool empty() const { return segments_.empty(); }
@@ -43,7 +48,10 @@ class SectionLines {
   std::optional<LineCrossing> exit_crossing(const Eigen::Vector2d& origin, const Eigen::Vector2d& direction,
                                             double u_min, double u_max, CrossingPick pick) const;
 
-  // True when p lies inside the section's material (even-odd over all loops).
+  // True when p lies inside the section's material (even-odd over all loops), or on its
+  // boundary (the section is closed). From the answer at the centre of p's cell, kept for every
+  // cell, and the contour vectors of that cell that the segment centre → p crosses. Built
+  // without SectionQueries::crossings_and_contains it tests every vector.
   bool contains(const Eigen::Vector2d& p) const;
 
  private:
@@ -55,6 +63,9 @@ class SectionLines {
   double z_mm_ = 0.0;
   std::vector<Segment> segments_;
   BoxGrid grid_;  // cell → indices into segments_
+  BoxGrid inside_grid_;                      // contains(): cell → indices into segments_
+  std::vector<std::uint8_t> centre_inside_;  // per cell of inside_grid_: its centre is material
+  void build_inside_grid(const std::vector<Box2>& boxes);
 };
 
 // du/dz of a surface with unit normal `normal` in the vertical plane along the horizontal unit
