@@ -9,6 +9,7 @@ side by side in one go compare.
 Each run of a plan writes to its own --out (…-a, …-b) so neither reads the other's files.
 """
 import argparse
+import os
 import re
 import statistics
 import subprocess
@@ -17,7 +18,7 @@ import tempfile
 import time
 
 
-def run_once(binary, args, tag):
+def run_once(binary, args, tag, env=None):
     args = list(args)
     if "--out" in args:
         i = args.index("--out") + 1
@@ -25,7 +26,7 @@ def run_once(binary, args, tag):
     start = time.monotonic()
     with tempfile.NamedTemporaryFile("r") as usage:
         done = subprocess.run(["/usr/bin/time", "-f", "%M %R", "-o", usage.name, binary] + args,
-                              capture_output=True, text=True)
+                              capture_output=True, text=True, env=env)
         wall = time.monotonic() - start
         rss_kib, faults = (int(x) for x in usage.read().split()[-2:])
     if done.returncode not in (0, 1):  # 1: a plan with warnings over the tolerance still plans
@@ -41,15 +42,24 @@ def run_once(binary, args, tag):
 def main():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--runs", type=int, default=3)
+    p.add_argument("--old-env", action="append", default=[], metavar="NAME=VALUE",
+                   help="run OLD with this in its environment (again for more)")
+    p.add_argument("--new-env", action="append", default=[], metavar="NAME=VALUE")
     p.add_argument("old")
     p.add_argument("new")
     p.add_argument("args", nargs=argparse.REMAINDER)
     a = p.parse_args()
     args = a.args[1:] if a.args[:1] == ["--"] else a.args
+    def env_with(pairs):
+        env = dict(os.environ)
+        for pair in pairs:
+            name, _, value = pair.partition("=")
+            env[name] = value
+        return env
     runs = {"old": [], "new": []}
     for _ in range(a.runs):
-        runs["old"].append(run_once(a.old, args, "a"))
-        runs["new"].append(run_once(a.new, args, "b"))
+        runs["old"].append(run_once(a.old, args, "a", env_with(a.old_env)))
+        runs["new"].append(run_once(a.new, args, "b", env_with(a.new_env)))
     keys = list(runs["new"][0])
     print(f"{'':12} {'old':>9} {'new':>9}   (median of {a.runs}, alternating)")
     for k in keys:
