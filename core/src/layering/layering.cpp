@@ -182,7 +182,7 @@ std::expected<Layering, Error> choose_layers(const Mesh& mesh, const LayeringPar
                       ? std::expected<layering_detail::LayerChoice, Error>(layering_detail::layer_greedy(est, params))
                       : layering_detail::layer_verified(est, mesh, params);
   if (!verified) return std::unexpected(verified.error());
-  const layering_detail::LayerChoice& choice = *verified;
+  layering_detail::LayerChoice& choice = *verified;
   if (choice.state_limit || choice.layers.empty()) return std::unexpected(rack_error(est, params, choice));
   const auto& chosen = choice.layers;
   Layering out;
@@ -200,7 +200,7 @@ std::expected<Layering, Error> choose_layers(const Mesh& mesh, const LayeringPar
   if (!choice.plans.empty() && choice.plans.size() == out.layers.size()) {
     auto plan = std::make_shared<BevelPlan>();
     plan->fit = params.fit;
-    plan->layers = choice.plans;
+    plan->layers = std::move(choice.plans);
     out.plan = std::move(plan);
   }
 

@@ -144,7 +144,7 @@ std::expected<LayerChoice, Error> layer_verified(Estimator& est, const Mesh& mes
       choice.plans.clear();
       break;
     }
-    choice.plans.push_back(it->second);
+    choice.plans.push_back(std::move(it->second));  // the cache ends here
     choice.plans.back().index = static_cast<int>(i);
   }
   return choice;

@@ -126,7 +126,9 @@ TEST(SectionLines, ContainsAnswersAsEvenOddOverTheWholeSlice) {
       }
       const bool want = brute_contains(slice, p);
       ASSERT_EQ(lines.contains(p), want) << "z " << z << " query " << q << " at " << p.transpose();
-      if (q % 10 == 0) ASSERT_EQ(without.contains(p), want) << "z " << z << " query " << q;
+      if (q % 10 == 0) {
+        ASSERT_EQ(without.contains(p), want) << "z " << z << " query " << q;
+      }
       (want ? inside : outside) += 1;
     }
     EXPECT_GT(inside, 2000);

@@ -94,7 +94,7 @@ struct Layering {
   // The optimal layering plans the layers it chooses (issue 17, item 4): their bevel plan, as
   // plan_bevels(mesh, layers, BevelParams{fit, sub_slice_mm, tolerance_mm, parallel} with the
   // other fields at their defaults) would make it; null when not every layer was planned.
-  std::shared_ptr<const BevelPlan> plan;
+  std::shared_ptr<BevelPlan> plan;
 };
 
 // Errors: invalid parameters (ErrorCode::invalid_argument), and a supply that cannot make a stack
