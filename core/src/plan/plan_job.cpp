@@ -121,7 +121,9 @@ std::expected<void, PlanJobError> layers_and_bevels(Run& run, const LayeringPara
   if (first_round) run.progress.start(PlanPhase::planning_bevels);
   t0 = Clock::now();
   if (run.r.layering.plan) {  // the layering planned its layers with these parameters already
-    run.r.plan = *run.r.layering.plan;
+    // Taken, not copied (the 1M sphere's plan is ~30 MB): nothing reads the layering's after this.
+    run.r.plan = std::move(*run.r.layering.plan);
+    run.r.layering.plan.reset();
   } else {
     auto plan = plan_bevels(run.mesh, run.r.layering.layers, bevel_params(run.q.settings, run.q.settings.strategy));
     if (!plan) return failed(PlanPhase::planning_bevels, plan.error());
