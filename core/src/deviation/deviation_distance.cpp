@@ -326,13 +326,9 @@ FarthestPoint max_surface_distance(const Mesh& mesh, const BevelPlan& plan, cons
   const FarthestPoint on_faces = farthest_on_faces(model, faces, params.distance_sample_mm, threads);
   if (on_faces.distance > stack_to_model.distance) stack_to_model = on_faces;
 
-  samples = mesh.vertices;
-  samples.reserve(samples.size() + mesh.faces.size());
-  for (const auto& f : mesh.faces)
-    samples.push_back((mesh.vertices[static_cast<std::size_t>(f[0])] + mesh.vertices[static_cast<std::size_t>(f[1])] +
-                       mesh.vertices[static_cast<std::size_t>(f[2])]) /
-                      3.0);
-  sort_morton(samples, threads);
+  // The model's vertices and centroids in its tree's (Morton) order: no sort of 1.5 M points for
+  // the 1M sphere (0.15 s). A vertex no facet uses is no surface point.
+  samples = model.vertices_and_centroids();
   const StackShells shells = build_stack_shells(plan);
   const TriangleTree stack(shells.vertices, shells.faces, threads);
   const FarthestPoint model_to_stack = max_distance(stack, samples, threads);

@@ -208,6 +208,17 @@ void sort_morton(std::vector<Eigen::Vector3d>& points, Threads threads) {
   points = std::move(sorted);
 }
 
+std::vector<Eigen::Vector3d> TriangleTree::vertices_and_centroids() const {
+  std::vector<Eigen::Vector3d> out;
+  out.reserve(verts_.size() + tris_.size());
+  out = verts_;
+  for (const auto& t : tris_)
+    out.push_back((verts_[static_cast<std::size_t>(t[0])] + verts_[static_cast<std::size_t>(t[1])] +
+                   verts_[static_cast<std::size_t>(t[2])]) /
+                  3.0);
+  return out;
+}
+
 double TriangleTree::distance(const Eigen::Vector3d& p, double enough, std::int32_t& hint) const {
   if (tris_.empty()) return std::numeric_limits<double>::infinity();
   const double enough2 = enough > 0.0 ? enough * enough : 0.0;

@@ -30,6 +30,11 @@ class TriangleTree {
 
   bool empty() const { return tris_.empty(); }
 
+  // Every vertex of the triangles once and every triangle's centroid ((a + b + c) / 3 of its
+  // corners in the mesh's order), both in the tree's order, which is near each other as on the
+  // surface: samples of the mesh ready for queries in order, without sorting them.
+  std::vector<Eigen::Vector3d> vertices_and_centroids() const;
+
   // Distance from p to the nearest triangle. When a triangle within `enough` is found the search
   // may stop there and return that triangle's distance (≤ enough): callers after a maximum of
   // nearest distances lose nothing by it. `hint` (a triangle of an earlier, nearby query; -1 for
