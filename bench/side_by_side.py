@@ -7,6 +7,8 @@ side by side in one go compare.
   bench/side_by_side.py OLD NEW -- plan /tmp/s1m.stl --out /tmp/sbs
 
 Each run of a plan writes to its own --out (…-a, …-b) so neither reads the other's files.
+--old-env / --new-env NAME=VALUE run one side with more in its environment (the same binary
+with and without LAMINA_MALLOC_TUNING=0, say). Needs /usr/bin/time (Debian's `time`).
 """
 import argparse
 import os
