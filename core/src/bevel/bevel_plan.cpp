@@ -111,6 +111,31 @@ void plan_each(const Mesh& mesh, const bevel_detail::MeshIndexes& indexes, std::
     for (std::size_t k = 0; k < order.size(); ++k) one(k);
 }
 
+// Checks, slices and plans the layers, layers[order[k]] for every k (a pool of tasks takes them
+// in that order), each with its index in `layers`.
+std::expected<std::vector<LayerPlan>, Error> plan_in_order(const Mesh& mesh, const bevel_detail::MeshIndexes& indexes,
+                                                           std::span<const LayerSpan> layers,
+                                                           const std::vector<std::size_t>& order,
+                                                           const BevelParams& params) {
+  if (auto ok = check_params(params); !ok) return std::unexpected(ok.error());
+  for (std::size_t i = 0; i < layers.size(); ++i)
+    if (!(layers[i].thickness_mm > 0.0) || !std::isfinite(layers[i].z_bottom_mm))
+      return invalid(fmt::format("layer {}: thickness must be > 0 mm (got {})", i, layers[i].thickness_mm));
+  auto sliced = slice_layers(mesh, layers, params);
+  if (!sliced) return std::unexpected(sliced.error());
+  OwnIndexes own;
+  const bevel_detail::MeshIndexes all = layers.empty() ? indexes : own.complete(mesh, indexes, params);
+  std::vector<LayerPlan> out;
+  plan_each(mesh, all, layers, *sliced, order, params, out);
+  return out;
+}
+
+std::vector<std::size_t> in_turn(std::size_t n) {
+  std::vector<std::size_t> order(n);
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  return order;
+}
+
 }  // namespace
 
 std::expected<BevelPlan, Error> plan_bevels(const Mesh& mesh, std::span<const LayerSpan> layers,
@@ -121,24 +146,16 @@ std::expected<BevelPlan, Error> plan_bevels(const Mesh& mesh, std::span<const La
 std::expected<BevelPlan, Error> bevel_detail::plan_bevels_on(const Mesh& mesh, const MeshIndexes& indexes,
                                                              std::span<const LayerSpan> layers,
                                                              const BevelParams& params) {
-  if (auto ok = check_params(params); !ok) return std::unexpected(ok.error());
-  for (std::size_t i = 0; i < layers.size(); ++i) {
-    const auto& l = layers[i];
-    if (!(l.thickness_mm > 0.0) || !std::isfinite(l.z_bottom_mm))
-      return invalid(fmt::format("layer {}: thickness must be > 0 mm (got {})", i, l.thickness_mm));
-    if (i > 0 && l.z_bottom_mm < layers[i - 1].z_top_mm() - 1e-9)
-      return invalid(fmt::format("layer {} starts at z = {} mm, below the top of layer {} ({} mm)", i, l.z_bottom_mm,
-                                 i - 1, layers[i - 1].z_top_mm()));
-  }
-  auto sliced = slice_layers(mesh, layers, params);
-  if (!sliced) return std::unexpected(sliced.error());
+  if (auto ok = check_params(params); !ok) return std::unexpected(ok.error());  // said before the layers
+  for (std::size_t i = 1; i < layers.size(); ++i)
+    if (layers[i].z_bottom_mm < layers[i - 1].z_top_mm() - 1e-9)
+      return invalid(fmt::format("layer {} starts at z = {} mm, below the top of layer {} ({} mm)", i,
+                                 layers[i].z_bottom_mm, i - 1, layers[i - 1].z_top_mm()));
+  auto planned = plan_in_order(mesh, indexes, layers, in_turn(layers.size()), params);
+  if (!planned) return std::unexpected(planned.error());
   BevelPlan plan;
   plan.fit = params.fit;
-  OwnIndexes own;
-  const MeshIndexes all = layers.empty() ? indexes : own.complete(mesh, indexes, params);
-  std::vector<std::size_t> order(layers.size());
-  std::iota(order.begin(), order.end(), std::size_t{0});
-  plan_each(mesh, all, layers, *sliced, order, params, plan.layers);
+  plan.layers = std::move(*planned);
   return plan;
 }
 
@@ -146,22 +163,11 @@ std::expected<std::vector<LayerPlan>, Error> bevel_detail::plan_layers_apart(con
                                                                              const MeshIndexes& indexes,
                                                                              std::span<const LayerSpan> layers,
                                                                              const BevelParams& params) {
-  if (auto ok = check_params(params); !ok) return std::unexpected(ok.error());
-  for (std::size_t i = 0; i < layers.size(); ++i)
-    if (!(layers[i].thickness_mm > 0.0) || !std::isfinite(layers[i].z_bottom_mm))
-      return invalid(fmt::format("layer {}: thickness must be > 0 mm (got {})", i, layers[i].thickness_mm));
-  auto sliced = slice_layers(mesh, layers, params);
-  if (!sliced) return std::unexpected(sliced.error());
-  OwnIndexes own;
-  const MeshIndexes all = layers.empty() ? indexes : own.complete(mesh, indexes, params);
   // The thickest first: the tasks that finish last are short ones.
-  std::vector<std::size_t> order(layers.size());
-  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::vector<std::size_t> order = in_turn(layers.size());
   std::stable_sort(order.begin(), order.end(),
                    [&](std::size_t a, std::size_t b) { return layers[a].thickness_mm > layers[b].thickness_mm; });
-  std::vector<LayerPlan> out;
-  plan_each(mesh, all, layers, *sliced, order, params, out);
-  return out;
+  return plan_in_order(mesh, indexes, layers, order, params);
 }
 
 }  // namespace lamina
