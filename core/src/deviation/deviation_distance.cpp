@@ -254,9 +254,10 @@ namespace {
 
 // The farthest of `samples` from the tree, each query allowed to stop at the first triangle
 // nearer than the farthest seen so far (`seen`, shared by the blocks and raised by them).
-FarthestPoint farthest_above(const TriangleTree& tree, std::span<const Eigen::Vector3d> samples, std::atomic<double>& seen,
+// `sample(i)` gives the i-th of `count` samples.
+template <class Sample>
+FarthestPoint farthest_above(const TriangleTree& tree, std::size_t count, const Sample& sample, std::atomic<double>& seen,
                              Threads threads) {
-  const std::size_t count = samples.size();
   constexpr std::size_t kBlock = 4096;
   const std::size_t blocks = (count + kBlock - 1) / kBlock;
   std::vector<FarthestPoint> block_max(blocks);
@@ -265,7 +266,7 @@ FarthestPoint farthest_above(const TriangleTree& tree, std::span<const Eigen::Ve
     FarthestPoint local;
     const std::size_t end = std::min(count, (b + 1) * kBlock);
     for (std::size_t i = b * kBlock; i < end; ++i) {
-      const Eigen::Vector3d& p = samples[i];
+      const Eigen::Vector3d p = sample(i);
       // Only a sample farther than everything seen can matter; the query may stop below that.
       const double enough = std::max(local.distance, seen.load(std::memory_order_relaxed));
       const double d = tree.distance(p, enough, hint);
@@ -290,11 +291,10 @@ FarthestPoint farthest_above(const TriangleTree& tree, std::span<const Eigen::Ve
   return best;
 }
 
-}  // namespace
-
-// The sample farthest from the tree (the first of equals, in sample order).
-FarthestPoint max_distance(const TriangleTree& tree, const std::vector<Eigen::Vector3d>& samples, Threads threads) {
-  if (samples.empty() || tree.empty()) return {};
+// The farthest of `count` samples from the tree (the first of equals, in sample order).
+template <class Sample>
+FarthestPoint farthest_of(const TriangleTree& tree, std::size_t count, const Sample& sample, Threads threads) {
+  if (count == 0 || tree.empty()) return {};
   std::atomic<double> seen{0.0};
   // 64 samples spread over the set first: the samples come in Morton order, so the farthest may
   // come last, and until the running maximum reaches it every query searches for its exact
@@ -303,14 +303,18 @@ FarthestPoint max_distance(const TriangleTree& tree, const std::vector<Eigen::Ve
   // (Every 16th sample, as before, cost more in exact searches than it saved once a query tries
   // its hint's neighbours: the 1M sphere's layer distances 0.61 → 0.49 thread-s.)
   constexpr std::size_t kSeeds = 64;
-  if (samples.size() >= 4 * kSeeds) {
-    const std::size_t stride = samples.size() / kSeeds;
-    std::vector<Eigen::Vector3d> spread;
-    spread.reserve(kSeeds + 1);
-    for (std::size_t i = 0; i < samples.size(); i += stride) spread.push_back(samples[i]);
-    (void)farthest_above(tree, spread, seen, threads);
+  if (count >= 4 * kSeeds) {
+    const std::size_t stride = count / kSeeds;
+    const std::size_t spread = (count + stride - 1) / stride;
+    (void)farthest_above(tree, spread, [&](std::size_t i) { return sample(i * stride); }, seen, threads);
   }
-  return farthest_above(tree, samples, seen, threads);
+  return farthest_above(tree, count, sample, seen, threads);
+}
+
+}  // namespace
+
+FarthestPoint max_distance(const TriangleTree& tree, const std::vector<Eigen::Vector3d>& samples, Threads threads) {
+  return farthest_of(tree, samples.size(), [&](std::size_t i) { return samples[i]; }, threads);
 }
 
 FarthestPoint max_surface_distance(const Mesh& mesh, const BevelPlan& plan, const DeviationParams& params) {
@@ -323,15 +327,19 @@ FarthestPoint max_surface_distance(const Mesh& mesh, const BevelPlan& plan, cons
                                   ? params.model_index->tree()
                                   : own_model.emplace(mesh.vertices, mesh.faces, threads);
   FarthestPoint stack_to_model = max_distance(model, samples, threads);
+  std::vector<Eigen::Vector3d>().swap(samples);  // each direction's samples and tree apart (peak memory)
   const FarthestPoint on_faces = farthest_on_faces(model, faces, params.distance_sample_mm, threads);
+  std::vector<FaceRegion>().swap(faces);
   if (on_faces.distance > stack_to_model.distance) stack_to_model = on_faces;
 
   // The model's vertices and centroids in its tree's (Morton) order: no sort of 1.5 M points for
-  // the 1M sphere (0.15 s). A vertex no facet uses is no surface point.
-  samples = model.vertices_and_centroids();
-  const StackShells shells = build_stack_shells(plan);
-  const TriangleTree stack(shells.vertices, shells.faces, threads);
-  const FarthestPoint model_to_stack = max_distance(stack, samples, threads);
+  // the 1M sphere (0.15 s), nor a copy of them. A vertex no facet uses is no surface point.
+  const TriangleTree stack = [&] {
+    const StackShells shells = build_stack_shells(plan);  // the tree keeps its own copy
+    return TriangleTree(shells.vertices, shells.faces, threads);
+  }();
+  const FarthestPoint model_to_stack = farthest_of(
+      stack, model.surface_sample_count(), [&](std::size_t i) { return model.surface_sample(i); }, threads);
   return model_to_stack.distance > stack_to_model.distance ? model_to_stack : stack_to_model;
 }
 

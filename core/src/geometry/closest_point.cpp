@@ -146,6 +146,7 @@ TriangleTree::TriangleTree(const std::vector<Eigen::Vector3d>& vertices,
                    vertices[static_cast<std::size_t>(faces[f][2])]) /
                   3.0;
   auto keys = morton_keys(centroid, threads);
+  std::vector<Eigen::Vector3d>().swap(centroid);  // not held while the rest is built (peak memory)
   sort_keys(keys, threads);
 
   tris_.resize(n);
@@ -162,6 +163,8 @@ TriangleTree::TriangleTree(const std::vector<Eigen::Vector3d>& vertices,
       tris_[i][k] = v;
     }
   }
+  std::vector<std::int32_t>().swap(renumbered);
+  decltype(keys)().swap(keys);
 
   std::map<std::size_t, std::size_t> memo;
   nodes_.resize(subtree_nodes(n, memo));
@@ -206,17 +209,6 @@ void sort_morton(std::vector<Eigen::Vector3d>& points, Threads threads) {
   auto gather = [&](std::size_t i) { sorted[i] = points[keys[i].second]; };
   for_each_index(points.size(), threads, gather);
   points = std::move(sorted);
-}
-
-std::vector<Eigen::Vector3d> TriangleTree::vertices_and_centroids() const {
-  std::vector<Eigen::Vector3d> out;
-  out.reserve(verts_.size() + tris_.size());
-  out = verts_;
-  for (const auto& t : tris_)
-    out.push_back((verts_[static_cast<std::size_t>(t[0])] + verts_[static_cast<std::size_t>(t[1])] +
-                   verts_[static_cast<std::size_t>(t[2])]) /
-                  3.0);
-  return out;
 }
 
 double TriangleTree::distance(const Eigen::Vector3d& p, double enough, std::int32_t& hint) const {

@@ -104,5 +104,22 @@ TEST(TriangleTreeTest, MortonOrderKeepsThePoints) {
   EXPECT_LT(step_sorted, 0.5 * step_random);
 }
 
+// The tree's surface samples are every vertex a triangle uses, once, and every triangle's
+// centroid: an unused vertex is no surface point, a shared one is not sampled twice.
+TEST(TriangleTreeTest, SurfaceSamplesAreTheUsedVerticesOnceAndEveryCentroid) {
+  std::vector<Eigen::Vector3d> vertices{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}, {9, 9, 9}};  // 4 unused
+  std::vector<std::array<std::int32_t, 3>> faces{{0, 1, 2}, {1, 3, 2}};
+  const TriangleTree tree(vertices, faces, geometry_detail::Threads::one);
+  ASSERT_EQ(tree.surface_sample_count(), 4u + 2u);
+  auto key = [](const Eigen::Vector3d& v) { return std::tuple(v.x(), v.y(), v.z()); };
+  std::vector<std::tuple<double, double, double>> got, want;
+  for (std::size_t i = 0; i < tree.surface_sample_count(); ++i) got.push_back(key(tree.surface_sample(i)));
+  for (int v = 0; v < 4; ++v) want.push_back(key(vertices[static_cast<std::size_t>(v)]));
+  for (const auto& f : faces) want.push_back(key((vertices[f[0]] + vertices[f[1]] + vertices[f[2]]) / 3.0));
+  std::sort(got.begin(), got.end());
+  std::sort(want.begin(), want.end());
+  EXPECT_EQ(got, want);
+}
+
 }  // namespace
 }  // namespace lamina
