@@ -46,7 +46,8 @@ double profile_slope(const Eigen::Vector3d& normal, const Eigen::Vector2d& direc
   return -nz / nd;
 }
 
-SectionLines::SectionLines(const Mesh& mesh, const Slice& slice, SectionQueries queries) : z_mm_(slice.z_mm) {
+SectionLines::SectionLines(const Mesh& mesh, const Slice& slice, SectionQueries queries)
+    : mesh_(&mesh), z_mm_(slice.z_mm) {
   std::size_t n = 0;
   for (const auto& l : slice.loops) n += l.size();
   segments_.reserve(n);
@@ -59,16 +60,6 @@ SectionLines::SectionLines(const Mesh& mesh, const Slice& slice, SectionQueries 
       s.a = l.points[i];
       s.b = l.points[(i + 1) % m];
       s.facet = l.facets[i];
-      if (s.facet >= 0) {
-        // A B-rep's surface normal half-way along the crossing (the facet's own for a mesh).
-        const Eigen::Vector2d mid = 0.5 * (s.a + s.b);
-        s.normal = surface_normal_at(mesh, s.facet, Eigen::Vector3d(mid.x(), mid.y(), slice.z_mm));
-        s.surface_id = mesh.surface_id[static_cast<std::size_t>(s.facet)];
-      } else {
-        const Eigen::Vector2d d = (s.b - s.a).normalized();
-        s.normal = Eigen::Vector3d(d.y(), -d.x(), 0.0);
-        s.surface_id = -1;
-      }
       lo = lo.cwiseMin(s.a).cwiseMin(s.b);
       hi = hi.cwiseMax(s.a).cwiseMax(s.b);
       segments_.push_back(s);
@@ -217,7 +208,7 @@ std::optional<LineCrossing> SectionLines::exit_crossing(const Eigen::Vector2d& o
     // Equal keys (u = ±a from the middle of a slot) go to the smaller u, whatever the walk's order.
     if (key < best_key || (key == best_key && best && u < best->u_mm)) {
       best_key = key;
-      best = LineCrossing{u, s.normal, s.surface_id, s.facet};
+      best = LineCrossing{u, Eigen::Vector3d::Zero(), -1, static_cast<std::int32_t>(idx)};  // completed below
     }
   };
   // Each walk runs where its t is the key (|u| outwards from u = 0, or −u inwards from u_max):
@@ -238,7 +229,23 @@ std::optional<LineCrossing> SectionLines::exit_crossing(const Eigen::Vector2d& o
     walk(direction, std::max(0.0, u_min), u_max);
     walk(-direction, std::max(0.0, -u_max), -u_min);
   }
+  if (best) *best = crossing_at(static_cast<std::size_t>(best->facet), best->u_mm);
   return best;
+}
+
+LineCrossing SectionLines::crossing_at(std::size_t index, double u_mm) const {
+  const Segment& s = segments_[index];
+  LineCrossing c{u_mm, Eigen::Vector3d::Zero(), -1, s.facet};
+  if (s.facet >= 0) {
+    // A B-rep's surface normal half-way along the crossing (the facet's own for a mesh).
+    const Eigen::Vector2d mid = 0.5 * (s.a + s.b);
+    c.normal = surface_normal_at(*mesh_, s.facet, Eigen::Vector3d(mid.x(), mid.y(), z_mm_));
+    c.surface_id = mesh_->surface_id[static_cast<std::size_t>(s.facet)];
+  } else {
+    const Eigen::Vector2d d = (s.b - s.a).normalized();
+    c.normal = Eigen::Vector3d(d.y(), -d.x(), 0.0);
+  }
+  return c;
 }
 
 bool SectionLines::contains(const Eigen::Vector2d& p) const {

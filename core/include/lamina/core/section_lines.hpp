@@ -55,11 +55,14 @@ class SectionLines {
   bool contains(const Eigen::Vector2d& p) const;
 
  private:
+  // 40 bytes: a crossing's normal and surface come from the mesh when it is returned, not kept
+  // for every vector (64 bytes with them; the layering's sub-slices of the 1M sphere held ~50 MB).
   struct Segment {
     Eigen::Vector2d a, b;
-    Eigen::Vector3d normal;
-    std::int32_t surface_id, facet;
+    std::int32_t facet;
   };
+  LineCrossing crossing_at(std::size_t index, double u_mm) const;
+  const Mesh* mesh_ = nullptr;  // outlives the lines (every user keeps both)
   double z_mm_ = 0.0;
   std::vector<Segment> segments_;
   BoxGrid grid_;  // cell → indices into segments_
