@@ -2,6 +2,7 @@
 // in, DIR/stack.stl, the sheets' programs and drawings and DIR/report.json out, tables printed.
 #include "as_cut_files.hpp"
 #include "commands.hpp"
+#include "malloc_tuning.hpp"
 #include "plan_cam.hpp"
 #include "plan_output.hpp"
 #include "plan_options.hpp"
@@ -159,8 +160,10 @@ int run_plan(const PlanOptions& o, const CamOptions& cam_options) {
   request.warnings = model_warnings(request.settings, mesh, o, request.cam);
 
   auto r = plan_job(mesh, request, [&](const PlanStep& step) {
-    if (step.done == 0 && step.total == 0)
+    if (step.done == 0 && step.total == 0) {
+      if (gives_back_freed_pages_before(step.phase)) give_back_freed_pages();
       progress.phase(plan_phase_name(step.phase));
+    }
     else
       progress.within(plan_phase_name(step.phase), step.done, step.total);
   });

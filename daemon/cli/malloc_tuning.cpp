@@ -2,6 +2,7 @@
 
 #include "own_path.hpp"
 
+#include <malloc.h>
 #include <unistd.h>
 
 #include <cstdlib>
@@ -76,6 +77,24 @@ void restart_with_malloc_tuning(int argc, char** argv) {
   ::execv(self ? self->c_str() : "/proc/self/exe", argv);
   // The restart failed: run as we are, and leave the environment as it was.
   if (had) ::setenv("GLIBC_TUNABLES", before.c_str(), 1); else ::unsetenv("GLIBC_TUNABLES");
+}
+
+bool gives_back_freed_pages_before(PlanPhase phase) {
+  switch (phase) {
+    case PlanPhase::nesting_and_programs:
+    case PlanPhase::measuring_deviation:
+    case PlanPhase::writing_stack: return true;
+    case PlanPhase::checking:
+    case PlanPhase::choosing_layers:
+    case PlanPhase::planning_bevels: return false;
+  }
+  return false;
+}
+
+void give_back_freed_pages() {
+#if defined(__GLIBC__)
+  ::malloc_trim(0);
+#endif
 }
 
 }  // namespace lamina::cli

@@ -12,6 +12,8 @@
 //    faults. A plan is a short process: what it frees and keeps is returned when it ends.
 // Not in sanitizer builds (their allocator is their own), nor when LAMINA_MALLOC_TUNING=0; a
 // tunable the user set is kept as the user set it.
+#include "lamina/core/plan_job.hpp"
+
 #include <optional>
 #include <string>
 #include <string_view>
@@ -31,5 +33,15 @@ std::optional<std::string> malloc_tunables(const MallocTuningInputs& in);
 
 // Returns only when it does not restart (or the restart failed: the command then runs as is).
 void restart_with_malloc_tuning(int argc, char** argv);
+
+// With those thresholds the heap keeps every page it frees, and a plan's phases free much: the
+// layering's sub-slices and verification plans (~100 MB of the 1M sphere) are free when the
+// nesting starts, but the toolpaths, the deviation's trees and the stack's bytes do not fit the
+// holes they left, so each phase grew the process anew (peak RSS 357 MiB). Before each phase that
+// follows the layering the free pages go back to the kernel (malloc_trim): 322 MiB, no slower
+// within the noise (docs/performance.md, issue 22, eleventh session). Not before the layering:
+// what the mesh's build freed is reused by it (no gain measured, more page faults).
+bool gives_back_freed_pages_before(PlanPhase phase);
+void give_back_freed_pages();
 
 }  // namespace lamina::cli

@@ -14,6 +14,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <functional>
 #include <cmath>
 #include <numeric>
 
@@ -305,8 +306,8 @@ std::vector<double> heights_by_step(double height_mm, double step_mm) {
   return zs;
 }
 
-std::expected<std::vector<Slice>, Error> slice_mesh(const Mesh& mesh, std::span<const double> zs,
-                                                    const SliceParams& params) {
+std::expected<void, Error> for_each_slice(const Mesh& mesh, std::span<const double> zs, const SliceParams& params,
+                                          const std::function<void(std::size_t, Slice&&)>& visit) {
   if (mesh.faces.empty()) return std::unexpected(Error{ErrorCode::empty_mesh, "slice: the mesh has no facets"});
   if (zs.size() > kMaxSlicePlanes)
     return std::unexpected(Error{ErrorCode::invalid_argument,
@@ -326,12 +327,11 @@ std::expected<std::vector<Slice>, Error> slice_mesh(const Mesh& mesh, std::span<
 
   const slice_detail::FacetBuckets buckets = slice_detail::bucket_facets(mesh, sorted_z);
 
-  std::vector<Slice> out(zs.size());
   tbb::enumerable_thread_specific<Scratch> scratch;
   auto run = [&](std::size_t k) {
     std::span<const std::int32_t> faces(buckets.faces.data() + buckets.offsets[k],
                                         buckets.faces.data() + buckets.offsets[k + 1]);
-    out[order[k]] = slice_one(mesh, faces, sorted_z[k], params, scratch.local());
+    visit(order[k], slice_one(mesh, faces, sorted_z[k], params, scratch.local()));
   };
   if (params.parallel) {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, sorted_z.size()),
@@ -341,6 +341,14 @@ std::expected<std::vector<Slice>, Error> slice_mesh(const Mesh& mesh, std::span<
   } else {
     for (std::size_t k = 0; k < sorted_z.size(); ++k) run(k);
   }
+  return {};
+}
+
+std::expected<std::vector<Slice>, Error> slice_mesh(const Mesh& mesh, std::span<const double> zs,
+                                                    const SliceParams& params) {
+  std::vector<Slice> out(zs.size());
+  auto done = for_each_slice(mesh, zs, params, [&](std::size_t i, Slice&& s) { out[i] = std::move(s); });
+  if (!done) return std::unexpected(done.error());
   return out;
 }
 

@@ -7,6 +7,8 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
+#include <mutex>
 #include <set>
 
 namespace lamina {
@@ -187,6 +189,40 @@ TEST(SliceBasic, ParallelAndSerialAgreeAndOrderFollowsInput) {
   }
   EXPECT_NEAR(a[0].net_area_mm2(), 100.0, 1e-9);
   EXPECT_NEAR(a[2].net_area_mm2(), 64.0, 1e-9);
+}
+
+// for_each_slice hands over every height's slice once, by its index in zs, the same slice
+// slice_mesh returns; a bad height is refused before any is handed over.
+TEST(SliceBasic, EachSliceIsHandedOverOnceByItsIndex) {
+  TriangleSoup soup = box({0, 0, 0}, {10, 10, 10});
+  soup = mesh_test::append(soup, mesh_test::inverted(box({2, 2, 2}, {8, 8, 8})));
+  const Mesh mesh = mesh_test::build_checked(soup);
+  std::vector<double> zs{9.0, 1.0, 5.0, 3.3, 7.7, 5.0};
+  const auto all = cut(mesh, zs);
+  for (const bool parallel : {false, true}) {
+    SliceParams p;
+    p.parallel = parallel;
+    std::vector<int> seen(zs.size(), 0);
+    std::vector<double> areas(zs.size(), -1.0), heights(zs.size(), -1.0);
+    std::mutex m;
+    auto done = for_each_slice(mesh, zs, p, [&](std::size_t i, Slice&& s) {
+      const std::lock_guard lock(m);
+      ASSERT_LT(i, zs.size());
+      ++seen[i];
+      areas[i] = s.net_area_mm2();
+      heights[i] = s.z_mm;
+    });
+    ASSERT_TRUE(done);
+    for (std::size_t i = 0; i < zs.size(); ++i) {
+      EXPECT_EQ(seen[i], 1) << i;
+      EXPECT_EQ(heights[i], zs[i]);
+      EXPECT_EQ(areas[i], all[i].net_area_mm2());
+    }
+  }
+  std::vector<double> bad{0.5, std::numeric_limits<double>::infinity()};
+  int calls = 0;
+  EXPECT_FALSE(for_each_slice(mesh, bad, SliceParams{}, [&](std::size_t, Slice&&) { ++calls; }));
+  EXPECT_EQ(calls, 0);
 }
 
 TEST(SliceBasic, RejectsNonFiniteHeights) {
