@@ -28,13 +28,23 @@ double segment_distance2(const Eigen::Vector3d& p, const Eigen::Vector3d& a, con
   return (a + t * ab - p).squaredNorm();
 }
 
-double box_distance2(const Eigen::Vector3d& p, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
+double box_distance2(const Eigen::Vector3d& p, const Eigen::Vector3f& lo, const Eigen::Vector3f& hi) {
   double d2 = 0.0;
   for (int k = 0; k < 3; ++k) {
-    const double d = std::max({lo[k] - p[k], 0.0, p[k] - hi[k]});
+    const double d = std::max({static_cast<double>(lo[k]) - p[k], 0.0, p[k] - static_cast<double>(hi[k])});
     d2 += d * d;
   }
   return d2;
+}
+
+// The nearest float on the far side of x, so that a box rounded so still holds what it held.
+float float_at_most(double x) {
+  const float f = static_cast<float>(x);
+  return static_cast<double>(f) <= x ? f : std::nextafter(f, -std::numeric_limits<float>::infinity());
+}
+float float_at_least(double x) {
+  const float f = static_cast<float>(x);
+  return static_cast<double>(f) >= x ? f : std::nextafter(f, std::numeric_limits<float>::infinity());
 }
 
 // f(i) for every i < n, on the threads allowed (in blocks of 16k: each call is a few ns).
@@ -172,13 +182,16 @@ TriangleTree::TriangleTree(const std::vector<Eigen::Vector3d>& vertices,
     Node& nd = nodes_[node];
     const std::size_t m = end - begin;
     if (m <= static_cast<std::size_t>(kLeafSize)) {
-      nd.lo = verts_[static_cast<std::size_t>(tris_[begin][0])];
-      nd.hi = nd.lo;
+      Eigen::Vector3d lo = verts_[static_cast<std::size_t>(tris_[begin][0])], hi = lo;
       for (std::size_t i = begin; i < end; ++i)
         for (const std::int32_t v : tris_[i]) {
-          nd.lo = nd.lo.cwiseMin(verts_[static_cast<std::size_t>(v)]);
-          nd.hi = nd.hi.cwiseMax(verts_[static_cast<std::size_t>(v)]);
+          lo = lo.cwiseMin(verts_[static_cast<std::size_t>(v)]);
+          hi = hi.cwiseMax(verts_[static_cast<std::size_t>(v)]);
         }
+      for (int k = 0; k < 3; ++k) {
+        nd.lo[k] = float_at_most(lo[k]);
+        nd.hi[k] = float_at_least(hi[k]);
+      }
       nd.first = static_cast<std::int32_t>(begin);
       nd.count = static_cast<std::int32_t>(m);
       return;

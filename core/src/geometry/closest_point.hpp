@@ -51,8 +51,11 @@ class TriangleTree {
   double distance(const Eigen::Vector3d& p, double enough, std::int32_t& hint) const;
 
  private:
+  // 32 bytes: the box in floats, rounded outwards, so it still holds its triangles (a query only
+  // prunes by it; distances are measured on the triangles in doubles). 56 bytes in doubles: the
+  // 1M sphere's tree was 12 MB larger, at the plan's peak.
   struct Node {
-    Eigen::Vector3d lo, hi;
+    Eigen::Vector3f lo, hi;
     std::int32_t first = 0;  // leaf: first triangle; inner: index of the right child (left is next)
     std::int32_t count = 0;  // leaf: triangles (> 0); inner: 0
   };

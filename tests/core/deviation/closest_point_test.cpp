@@ -104,6 +104,29 @@ TEST(TriangleTreeTest, MortonOrderKeepsThePoints) {
   EXPECT_LT(step_sorted, 0.5 * step_random);
 }
 
+// The nodes' boxes are floats: rounded outwards they still hold their triangles where a float
+// cannot say the coordinates (a float's step at 100 km is 8 mm, the triangles here are 1 µm
+// apart), so a point on a triangle is found on it. Rounded to nearest, boxes would cut off
+// corners and a query would settle for a neighbour.
+TEST(TriangleTreeTest, FloatBoxesStillHoldTheirTrianglesFarFromTheOrigin) {
+  std::vector<Eigen::Vector3d> vertices;
+  std::vector<std::array<std::int32_t, 3>> faces;
+  const Eigen::Vector3d far(1e5 + 0.0031, -2e5 + 0.0057, 3e4 + 0.0013);
+  for (int i = 0; i < 400; ++i) {
+    const Eigen::Vector3d c = far + Eigen::Vector3d(1e-3 * (i % 20), 1e-3 * (i / 20), 1e-4 * (i % 7));
+    const auto base = static_cast<std::int32_t>(vertices.size());
+    vertices.push_back(c);
+    vertices.push_back(c + Eigen::Vector3d(4e-4, 0, 0));
+    vertices.push_back(c + Eigen::Vector3d(0, 4e-4, 1e-4));
+    faces.push_back({base, base + 1, base + 2});
+  }
+  const TriangleTree tree(vertices, faces, geometry_detail::Threads::one);
+  for (std::size_t v = 0; v < vertices.size(); ++v) {
+    std::int32_t hint = -1;
+    EXPECT_EQ(tree.distance(vertices[v], 0.0, hint), 0.0) << v;
+  }
+}
+
 // The tree's surface samples are every vertex a triangle uses, once, and every triangle's
 // centroid: an unused vertex is no surface point, a shared one is not sampled twice.
 TEST(TriangleTreeTest, SurfaceSamplesAreTheUsedVerticesOnceAndEveryCentroid) {
