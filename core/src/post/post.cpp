@@ -21,6 +21,7 @@ namespace {
 
 using post_detail::format_number;
 using post_detail::format_significant;
+using post_detail::rounded_poses;
 
 constexpr double deg_per_rad = 180.0 / std::numbers::pi;
 constexpr double s_per_min = 60.0;
@@ -58,70 +59,6 @@ std::string contour_marker(std::size_t index, const ToolContour& c) {
   if (c.frees) s += " FREES";
   if (!c.closed) s += " OPEN";
   return "(" + post_detail::comment_text(s, post_detail::max_line_chars - 2) + ")";
-}
-
-// Poses as the controller will read them. Without RTCP, A and C are read rounded to
-// angular_decimals, and X Y Z are computed from those rounded angles, so the tip lands where
-// planned (to the linear rounding).
-std::vector<AxisPose> rounded_poses(const SheetToolpath& toolpath, const HeadKinematics& head, const PostParams& params,
-                                    std::vector<AxisPose> poses) {
-  if (head.rtcp) return poses;
-  // An angle as the controller reads it when written with `decimals` decimals of a degree.
-  auto rounded = [](double rad, int decimals) {
-    const double scale = std::pow(10.0, decimals);
-    return std::round(rad * deg_per_rad * scale) / scale / deg_per_rad;
-  };
-  // A and C are held while the axis they give stays so near the planned one that the cut's far
-  // face moves by less than one linear step (the sheet's thickness times the angle between
-  // them): a bevel's stations alternate by a hundredth of a degree or less, and rewriting A, C
-  // and the X Y Z they move for each of them was a fifth of a pivot program's bytes. The tip
-  // still lands where planned: X Y Z are computed from the angles held.
-  const double far_face_mm = std::pow(10.0, -params.linear_decimals);
-  const bool hold = params.hold_rotary_within_step && toolpath.thickness_mm > 0.0;
-  std::optional<std::pair<double, double>> held;  // A, C as last written
-  auto near_enough = [&](double a, double c, const Eigen::Vector3d& planned) {
-    const Eigen::Vector3d axis = tool_axis_at(a, c, head);
-    return toolpath.thickness_mm * axis.cross(planned).norm() <= far_face_mm * axis.dot(planned);
-  };
-  // Fewer decimals where the far face allows them: C moves the axis by sin A times its own
-  // error, so a nearly vertical head's C needs none; A moves it one for one. C first, then A.
-  auto shortest_within = [&](std::pair<double, double> ac, const Eigen::Vector3d& planned) {
-    auto fewest = [&](double rad, auto&& fits) {
-      for (int d = 0; d < params.angular_decimals; ++d)
-        if (const double r = rounded(rad, d); fits(r)) return r;
-      return rad;
-    };
-    ac.second = fewest(ac.second, [&](double c) { return near_enough(ac.first, c, planned); });
-    ac.first = fewest(ac.first, [&](double a) { return near_enough(a, ac.second, planned); });
-    return ac;
-  };
-  for (std::size_t i = 0; i < poses.size(); ++i) {
-    AxisPose& p = poses[i];
-    std::pair<double, double> ac{rounded(p.a_rad, params.angular_decimals), rounded(p.c_rad, params.angular_decimals)};
-    if (hold && held) {
-      // Only a small difference is held: never C a turn away, nor A through zero (the same axis).
-      constexpr double kMostHeldRad = 1.0 / deg_per_rad;
-      const bool a_holds = std::abs(held->first - ac.first) <= kMostHeldRad;
-      const bool c_holds = std::abs(held->second - ac.second) <= kMostHeldRad;
-      const Eigen::Vector3d planned = tool_axis_at(p.a_rad, p.c_rad, head);
-      if (a_holds && c_holds && near_enough(held->first, held->second, planned))
-        ac = *held;
-      else if (a_holds && near_enough(held->first, ac.second, planned))
-        ac.first = held->first;
-      else if (c_holds && near_enough(ac.first, held->second, planned))
-        ac.second = held->second;
-    }
-    if (hold && ac != held) ac = shortest_within(ac, tool_axis_at(p.a_rad, p.c_rad, head));
-    held = ac;
-    p.a_rad = ac.first;
-    p.c_rad = ac.second;
-    const Eigen::Vector3d xyz =
-        toolpath.moves[i].tip_mm + head.pivot_mm * (tool_axis_at(p.a_rad, p.c_rad, head) - Eigen::Vector3d::UnitZ());
-    p.x_mm = xyz.x();
-    p.y_mm = xyz.y();
-    p.z_mm = xyz.z();
-  }
-  return poses;
 }
 
 constexpr std::array<char, 5> kAxisLetters{'X', 'Y', 'Z', 'A', 'C'};

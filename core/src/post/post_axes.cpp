@@ -14,7 +14,6 @@ namespace lamina::post_detail {
 namespace {
 
 constexpr double two_pi = 2.0 * std::numbers::pi;
-constexpr double deg_per_rad = 180.0 / std::numbers::pi;
 constexpr double range_slack_rad = 1e-9;
 constexpr double same_height_mm = 1e-6;
 

@@ -7,10 +7,13 @@
 
 #include <cstddef>
 #include <expected>
+#include <numbers>
 #include <string>
 #include <vector>
 
 namespace lamina::post_detail {
+
+inline constexpr double deg_per_rad = 180.0 / std::numbers::pi;
 
 // Lines are kept shorter than this (newline excluded): Grbl 1.1 reads at most 80 characters a
 // line (protocol.h LINE_BUFFER_SIZE 80); grblHAL 256, LinuxCNC and Fanuc more.
@@ -22,6 +25,13 @@ inline constexpr std::size_t max_line_chars = 69;
 // Errors name the contour (or rapid move) that the head cannot reach.
 std::expected<std::vector<AxisPose>, Error> plan_machine_axes(const SheetToolpath& toolpath,
                                                              const HeadKinematics& head);
+
+// Poses as the controller will read them (post_rotary.cpp). Without RTCP, A and C are read
+// rounded to angular_decimals, or held and shortened within one linear step at the sheet's far
+// face (PostParams::hold_rotary_within_step), and X Y Z are computed from the angles written, so
+// the tip lands where planned (to the linear rounding). RTCP poses are returned as they are.
+std::vector<AxisPose> rounded_poses(const SheetToolpath& toolpath, const HeadKinematics& head, const PostParams& params,
+                                    std::vector<AxisPose> poses);
 
 // Dialect rules.
 std::expected<void, Error> check_post_setup(const HeadKinematics& head, const PostParams& params);

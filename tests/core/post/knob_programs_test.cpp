@@ -1,7 +1,7 @@
 // The example part end to end through the core: layers → bevel plan → parts → nest → toolpaths →
 // programs in every dialect, read back by the test's own reader and forward kinematics: every move
 // end reproduces the planned tip within 1 µm and the axis within 0.01°, tilt within the limit, no C
-// jump, and compact lines (≤ 30 bytes per 5-axis move on average with RTCP).
+// jump, and compact lines (≤ 30 bytes per 5-axis move on average, on every post).
 #include "post_round_trip.hpp"
 
 #include "lamina/core/bevel.hpp"
@@ -100,9 +100,7 @@ TEST_P(KnobPrograms, EveryMoveEndOfEverySheetIsThePlannedTipAndAxis) {
   RecordProperty("bytes_per_five_axis_move", std::to_string(per_move));
   std::printf("%s %s: %zu five-axis moves, %.1f bytes each\n", lamina::post_dialect_name(params.dialect),
               head.rtcp ? "RTCP" : "pivot+G93", moves5, per_move);
-  if (head.rtcp) {
-    EXPECT_LE(per_move, 30.0);
-  }
+  EXPECT_LE(per_move, 30.0);  // issue 22, on every post: RTCP ~27, pivot + G93 28.2 (grblHAL, LinuxCNC) and 29.2 (Fanuc)
 }
 
 INSTANTIATE_TEST_SUITE_P(Dialects, KnobPrograms,
