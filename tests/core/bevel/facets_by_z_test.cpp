@@ -5,7 +5,9 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <random>
+#include <utility>
 
 namespace lamina {
 namespace {
@@ -84,6 +86,27 @@ TEST(FacetsByZ, AnEmptyMeshHasNoFacetsInAnySlab) {
   std::vector<std::uint32_t> got{1, 2};
   index.in_slab(0.0, 10.0, got);
   EXPECT_TRUE(got.empty());
+}
+
+// The index keeps each facet's heights as floats rounded outwards: slabs that end exactly on a
+// facet's lowest or highest point, or a double's step beside it (far below a float's), must
+// give what the doubles give.
+TEST(FacetsByZ, SlabsEndingOnAFacetsHeightOrADoublesStepBesideIt) {
+  const Mesh m = random_triangles(2000, 100.0, 0, 4);
+  const FacetsByZ index(m, 0.5);
+  std::vector<std::uint32_t> got;
+  const double inf = std::numeric_limits<double>::infinity();
+  for (std::size_t f = 0; f < m.faces.size(); f += 7) {
+    for (const auto& corner : m.faces[f]) {
+      const double z = m.vertices[static_cast<std::size_t>(corner)].z();
+      for (const double end : {std::nextafter(z, -inf), z, std::nextafter(z, inf)}) {
+        for (const auto& [zb, zt] : {std::pair{end, end + 0.25}, std::pair{end - 0.25, end}, std::pair{end, end}}) {
+          index.in_slab(zb, zt, got);
+          ASSERT_EQ(got, scanned(m, zb, zt)) << "slab " << zb << " .. " << zt;
+        }
+      }
+    }
+  }
 }
 
 }  // namespace
