@@ -93,7 +93,10 @@ bool gives_back_freed_pages_before(PlanPhase phase) {
 
 void give_back_freed_pages() {
 #if defined(__GLIBC__)
-  ::malloc_trim(0);
+  // A small plan's few free pages are not worth faulting in again (the knob: 3 200 → 7 900
+  // faults, 0.83 → 0.87 s, for 2 MiB).
+  constexpr std::size_t kWorthGivingBack = 32u << 20;
+  if (::mallinfo2().fordblks >= kWorthGivingBack) ::malloc_trim(0);
 #endif
 }
 

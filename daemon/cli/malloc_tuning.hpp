@@ -40,7 +40,8 @@ void restart_with_malloc_tuning(int argc, char** argv);
 // holes they left, so each phase grew the process anew (peak RSS 357 MiB). Before each phase that
 // follows the layering the free pages go back to the kernel (malloc_trim): 322 MiB, no slower
 // within the noise (docs/performance.md, issue 22, eleventh session). Not before the layering:
-// what the mesh's build freed is reused by it (no gain measured, more page faults).
+// what the mesh's build freed is reused by it (no gain measured, more page faults). Only when at
+// least 32 MiB is free: a small plan's few pages are not worth faulting in again.
 bool gives_back_freed_pages_before(PlanPhase phase);
 void give_back_freed_pages();
 
