@@ -70,9 +70,11 @@ class MemoryPlc final : public RegisterBus {
     if (pending_) in_[kInMailboxAck] = *pending_;
     pending_.reset();
   }
-  void refuse_next_block() {
+  // The block with this mailbox_seq is refused (bad block alarm), whenever it comes: set before
+  // the job starts, so the test does not race the link's thread.
+  void refuse_block(std::uint16_t seq) {
     std::lock_guard lock(m_);
-    refuse_next_ = true;
+    refuse_seq_ = seq;
   }
   // Reads of the input registers so far (the link polls them while it waits).
   long input_reads() const {
@@ -158,10 +160,7 @@ class MemoryPlc final : public RegisterBus {
     last_seq_ = seq;
     if (pending_) return latch(kAlarmMailboxOverrun);  // the new block is discarded
     const std::size_t length = hold_[kHoldMailboxLength];
-    if (length > 200 || refuse_next_) {
-      refuse_next_ = false;
-      return latch(kAlarmMailboxBadBlock);
-    }
+    if (length > 200 || (refuse_seq_ != 0 && seq == refuse_seq_)) return latch(kAlarmMailboxBadBlock);
     std::string text;
     for (std::size_t i = 0; i < length; ++i) {
       const std::uint16_t word = hold_[kHoldMailboxText + i / 2];
@@ -183,7 +182,8 @@ class MemoryPlc final : public RegisterBus {
   std::vector<std::string> blocks_;
   std::uint16_t last_seq_ = 0;
   std::optional<std::uint16_t> pending_;
-  bool hold_acks_ = false, refuse_next_ = false;
+  bool hold_acks_ = false;
+  std::uint16_t refuse_seq_ = 0;
   long input_reads_ = 0;
 };
 
