@@ -10,8 +10,9 @@ namespace lamina::drivers {
 namespace pm = plc_map;
 
 std::string describe_line(std::size_t index, std::string_view line) {
-  if (line.size() > 60) return fmt::format("line {} '{}…' ({} characters)", index, line.substr(0, 60), line.size());
-  return fmt::format("line {} '{}'", index, line);
+  const std::size_t number = index + 1;
+  if (line.size() > 60) return fmt::format("line {} '{}…' ({} characters)", number, line.substr(0, 60), line.size());
+  return fmt::format("line {} '{}'", number, line);
 }
 
 std::optional<LinkError> check_mailbox_block(std::size_t index, std::string_view line) {

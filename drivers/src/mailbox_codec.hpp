@@ -29,7 +29,9 @@ inline std::uint16_t next_mailbox_seq(std::uint16_t seq) { return seq >= 65535 ?
 // millidegrees converted to mm and degrees here), free planner blocks.
 ControllerStatus decode_cnc_status(std::span<const std::uint16_t> input_registers);
 
-// "line 12 'G1X10'": how errors name a line (long lines shortened).
+// "line 13 'G1X10'" for the program's index 12: how errors name a line, counted from 1 as the
+// program's lines are (an editor's, the contour markers', the serial streamer's) and long lines
+// shortened. (It said the 0-based index: an operator looked one line too early.)
 std::string describe_line(std::size_t index, std::string_view line);
 
 }  // namespace lamina::drivers
