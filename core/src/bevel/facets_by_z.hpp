@@ -3,6 +3,7 @@
 // visits the facets of its own slab instead of every facet of the mesh. On the 1M-triangle
 // sphere each of the ~30 planned layers scanned all 1M facets twice (its shadows and its slab),
 // gathering a few tens of thousands.
+#include "geometry/outward_float.hpp"
 #include "lamina/core/mesh.hpp"
 
 #include <algorithm>
@@ -22,8 +23,8 @@ class FacetsByZ {
     double z_min = std::numeric_limits<double>::infinity(), z_max = -z_min;
     for (std::size_t f = 0; f < n; ++f) {
       const double lo = z_lo(f), hi = z_hi(f);
-      lo_[f] = float_at_most(lo);
-      hi_[f] = float_at_least(hi);
+      lo_[f] = geometry_detail::float_at_most(lo);
+      hi_[f] = geometry_detail::float_at_least(hi);
       z_min = std::min(z_min, lo);
       z_max = std::max(z_max, hi);
     }
@@ -76,14 +77,6 @@ class FacetsByZ {
   // More than a float's relative rounding (2^-24 ≈ 6e-8): within it of an end, a bound may be the
   // rounding's and not the facet's.
   static constexpr double kFloatSlack = 1e-6;
-  static float float_at_most(double x) {
-    const float f = static_cast<float>(x);
-    return static_cast<double>(f) <= x ? f : std::nextafter(f, -std::numeric_limits<float>::infinity());
-  }
-  static float float_at_least(double x) {
-    const float f = static_cast<float>(x);
-    return static_cast<double>(f) >= x ? f : std::nextafter(f, std::numeric_limits<float>::infinity());
-  }
   std::int64_t bin_of(double z) const {
     // Clamped as a double first: a height far outside the mesh must not overflow the cast.
     const double b = std::clamp(std::floor((z - z0_) / bin_mm_), 0.0, static_cast<double>(bins_ - 1));

@@ -1,4 +1,5 @@
 #include "geometry/closest_point.hpp"
+#include "geometry/outward_float.hpp"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -35,16 +36,6 @@ double box_distance2(const Eigen::Vector3d& p, const Eigen::Vector3f& lo, const 
     d2 += d * d;
   }
   return d2;
-}
-
-// The nearest float on the far side of x, so that a box rounded so still holds what it held.
-float float_at_most(double x) {
-  const float f = static_cast<float>(x);
-  return static_cast<double>(f) <= x ? f : std::nextafter(f, -std::numeric_limits<float>::infinity());
-}
-float float_at_least(double x) {
-  const float f = static_cast<float>(x);
-  return static_cast<double>(f) >= x ? f : std::nextafter(f, std::numeric_limits<float>::infinity());
 }
 
 // f(i) for every i < n, on the threads allowed (in blocks of 16k: each call is a few ns).

@@ -21,9 +21,9 @@ namespace {
 
 using post_detail::format_number;
 using post_detail::format_significant;
+using post_detail::deg_per_rad;
 using post_detail::rounded_poses;
 
-constexpr double deg_per_rad = 180.0 / std::numbers::pi;
 constexpr double s_per_min = 60.0;
 // A feed move whose tip travels less than this is a pure reorientation: its G93 time comes from
 // the arc the pivot travels instead (the tip distance would make it instantaneous).

@@ -93,29 +93,40 @@ TEST(PostRoundTrip, SignsOffsetAndPivotOfAnotherHead) {
   }
 }
 
+// An edge of 201 stations 0.5 mm apart on a 6 mm sheet whose tilt alternates 20° / 20° + step.
+SheetToolpath alternating_edge(double step_deg) {
+  ContourSpec edge;
+  for (int k = 0; k <= 200; ++k) {
+    const double tilt = (20.0 + (k % 2 ? step_deg : 0.0)) * deg;
+    edge.stations.push_back({{100.0 + 0.5 * k, 100.0, 0.0}, tilted(tilt, -std::numbers::pi / 2)});
+  }
+  return make_toolpath({edge});
+}
+
+PostParams grblhal_pivot_params() {
+  PostParams params;
+  params.dialect = PostDialect::grblhal;
+  params.angular_decimals = 3;
+  return params;
+}
+
+std::size_t a_words(const std::string& text) {
+  std::size_t n = 0;
+  for (const std::string& line : split_lines(text))
+    if (line.find('A') != std::string::npos && line.front() != '(') ++n;
+  return n;
+}
+
 // A bevel's stations alternate: at a mesh's vertices and between them the tilt differs by a few
 // thousandths of a degree. A pivot post holds A and C while the far face stays within a linear
 // step (here 0.006° on a 6 mm sheet is 0.63 µm), so A is written once along the edge, not on
 // every line; X Y Z follow the angle held, so the tip is where planned. Off, A alternates.
 TEST(PostRoundTrip, APivotPostHoldsARotaryWordWhileTheFarFaceStaysWithinAStep) {
-  ContourSpec edge;
-  for (int k = 0; k <= 200; ++k) {
-    const double tilt = (20.0 + (k % 2 ? 0.006 : 0.0)) * deg;
-    edge.stations.push_back({{100.0 + 0.5 * k, 100.0, 0.0}, tilted(tilt, -std::numbers::pi / 2)});
-  }
-  const SheetToolpath tp = make_toolpath({edge});
+  const SheetToolpath tp = alternating_edge(0.006);
   ASSERT_DOUBLE_EQ(tp.thickness_mm, 6.0);
   HeadKinematics head;
   head.rtcp = false;
-  PostParams params;
-  params.dialect = PostDialect::grblhal;
-  params.angular_decimals = 3;
-  auto a_words = [](const std::string& text) {
-    std::size_t n = 0;
-    for (const std::string& line : split_lines(text))
-      if (line.find('A') != std::string::npos && line.front() != '(') ++n;
-    return n;
-  };
+  PostParams params = grblhal_pivot_params();
   const RoundTrip held = round_trip(tp, head, params);  // tip within 1 µm, far face within 1 µm
   params.hold_rotary_within_step = false;
   const RoundTrip every = round_trip(tp, head, params);
@@ -132,23 +143,12 @@ TEST(PostRoundTrip, APivotPostHoldsARotaryWordWhileTheFarFaceStaysWithinAStep) {
 // at the far face is 0.0095°), so the last A written could never be held, but their windows
 // overlap and one A between them serves the whole run (issue 22: the knob's 2.5 mm layers).
 TEST(PostRoundTrip, APivotPostWritesOneAForARunOfAlternatingStationsWhoseWindowsOverlap) {
-  ContourSpec edge;
-  for (int k = 0; k <= 200; ++k) {
-    const double tilt = (20.0 + (k % 2 ? 0.016 : 0.0)) * deg;
-    edge.stations.push_back({{100.0 + 0.5 * k, 100.0, 0.0}, tilted(tilt, -std::numbers::pi / 2)});
-  }
-  const SheetToolpath tp = make_toolpath({edge});
+  const SheetToolpath tp = alternating_edge(0.016);
   ASSERT_DOUBLE_EQ(tp.thickness_mm, 6.0);
   HeadKinematics head;
   head.rtcp = false;
-  PostParams params;
-  params.dialect = PostDialect::grblhal;
-  params.angular_decimals = 3;
-  const RoundTrip held = round_trip(tp, head, params);  // tip within 1 µm, far face within 1 µm
-  std::size_t a_words = 0;
-  for (const std::string& line : split_lines(held.posted.text))
-    if (line.find('A') != std::string::npos && line.front() != '(') ++a_words;
-  EXPECT_LT(a_words, 12u) << held.posted.text.substr(0, 600);  // the rapids and the lead-in turn, then one A
+  const RoundTrip held = round_trip(tp, head, grblhal_pivot_params());  // tip and far face within 1 µm
+  EXPECT_LT(a_words(held.posted.text), 12u) << held.posted.text.substr(0, 600);  // the rapids and the lead-in turn, then one A
 }
 
 TEST(PostRoundTrip, CompactTypicalCutWithRtcpIsUnder30BytesPerFiveAxisMove) {
