@@ -12,6 +12,7 @@
 
 #include <chrono>
 #include <cstdio>
+#include <numbers>
 #include <random>
 
 namespace lamina {
@@ -143,7 +144,23 @@ TEST(NestFit, InnerProxyOfANearlyConvexHoleIsInsideItAndSmall) {
   Polygon2 notched = circle(80, 400);
   for (int i = 0; i < 5; ++i) notched[static_cast<std::size_t>(i)] *= 75.0 / 80.0;
   const Path deep = to_path(notched);
-  EXPECT_EQ(cam_detail::inner_proxy(deep), deep);  // a real pocket: the ring itself
+  // A real pocket: not convex, so the ring simplified inwards (a room's corners multiply the
+  // inner fit's cost): inside it, within 75 µm of it, fewer corners.
+  const Path deep_proxy = cam_detail::inner_proxy(deep);
+  EXPECT_LT(deep_proxy.size(), deep.size() / 2);
+  EXPECT_EQ(area_of(clip(ClipperLib::ctDifference, {deep_proxy}, {deep})), 0.0) << "the proxy must lie inside the hole";
+  EXPECT_EQ(area_of(clip(ClipperLib::ctDifference, cam_detail::offset_mitre({deep}, -0.075), {deep_proxy})), 0.0)
+      << "nowhere more than 75 µm inside";
+}
+
+// Before a ring of 2·10¹⁶ nm² could be simplified at all, is_simple compared the areas in nm²
+// to 1, below a double's step there (4): a Ø160 mm hole was never simplified inwards.
+TEST(NestFit, SimplifiedInsideOfALargeRoundRoomHasFewerCorners) {
+  const Path ring = to_path(circle(80, 400));
+  const Path s = cam_detail::simplified_inside(ring);
+  EXPECT_LT(s.size(), ring.size() / 2);
+  EXPECT_EQ(area_of(clip(ClipperLib::ctDifference, {s}, {ring})), 0.0);
+  EXPECT_EQ(cam_detail::simplified_outside(ring).size() < ring.size() / 2, true);
 }
 
 // A U of many corners, as a layer of a vase cut along its axis comes out: two round-ended walls
@@ -193,6 +210,75 @@ TEST(NestFit, WithoutNoFitEqualsSubtractingEachNoFitRegion) {
       EXPECT_LT(area_of(clip(ClipperLib::ctXor, got, want)), 1e-6) << area_of(got) << " vs " << area_of(want);
     }
   }
+}
+
+// The general inner fit as its formula states it: (room − c0) less every room ring's whole band
+// ∂r ⊕ ∂(−C) (Clipper's MinkowskiSum, which unites all its parallelograms) and r0 − C. What
+// inner_fit_general must equal, however it gets there.
+Paths whole_inner_fit(const Paths& room, const Path& c) {
+  const Path neg = cam_detail::negated(c);
+  ClipperLib::Clipper clipper;
+  for (const Path& r : room) {
+    clipper.AddPath(cam_detail::translated(r, {-c.front().X, -c.front().Y}), ClipperLib::ptSubject, true);
+    Paths band;
+    ClipperLib::MinkowskiSum(neg, r, band, true);
+    clipper.AddPaths(band, ClipperLib::ptClip, true);
+    clipper.AddPath(cam_detail::translated(neg, r.front()), ClipperLib::ptClip, true);
+  }
+  Paths out;
+  clipper.Execute(ClipperLib::ctDifference, out, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
+  return out;
+}
+
+// A ring of n corners at radius r (1 + a sin(k θ)): not convex, like the sponge's rooms.
+Path wavy(double r, double a, int k, int n, double cx = 0, double cy = 0) {
+  Polygon2 ring;
+  for (int i = 0; i < n; ++i) {
+    const double th = 2 * std::numbers::pi * i / n;
+    const double rr = r * (1 + a * std::sin(k * th));
+    ring.emplace_back(cx + rr * std::cos(th), cy + rr * std::sin(th));
+  }
+  return to_path(ring);
+}
+
+Path rotated_path(const Path& ring, double deg) {
+  const double a = deg * std::numbers::pi / 180, co = std::cos(a), si = std::sin(a);
+  Path out;
+  for (const auto& q : ring)
+    out.push_back({std::llround(co * static_cast<double>(q.X) - si * static_cast<double>(q.Y)),
+                   std::llround(si * static_cast<double>(q.X) + co * static_cast<double>(q.Y))});
+  return out;
+}
+
+// Non-convex rooms (one ring, and one with an island a child left), candidates small, nearly
+// filling the room (its own ring eroded 0.3 mm: hundreds of corners), turned a little so that they
+// no longer fit, and a little larger than the room: the region the corners' patch bounds is the
+// whole formula's region, and empty exactly when that is.
+TEST(NestFit, GeneralInnerFitOfNonConvexRoomsEqualsTheWholeFormula) {
+  const Path outer = wavy(60, 0.2, 5, 136);
+  const Path island = [] {
+    Path p = wavy(8, 0.3, 3, 24, 25, 0);
+    ClipperLib::ReversePath(p);  // a hole in the room: clockwise
+    return p;
+  }();
+  const Path snug = cam_detail::offset_mitre({outer}, -0.3).front();
+  const Path too_big = cam_detail::offset_mitre({outer}, 0.05).front();
+  int fitting = 0, empty = 0;
+  for (const Paths& room : {Paths{outer}, Paths{outer, island}}) {
+    for (const Path& c : {snug, rotated_path(snug, 0.2), rotated_path(snug, 2.0), too_big,
+                          to_path(ell(30, 20, 8, -10, -10)), to_path(circle(12, 40, 5, 5)), wavy(20, 0.25, 4, 90)}) {
+      SCOPED_TRACE(::testing::Message() << c.size() << " corners in a room of " << room.size() << " ring(s)");
+      const Paths want = whole_inner_fit(room, c);
+      const Paths got = cam_detail::inner_fit_general(room, c);
+      // Both regions are rounded to nm along boundaries hundreds of mm long: 1e-5 mm² is that
+      // rounding (1.1e-6 was seen), a wrong piece is square millimetres.
+      EXPECT_LT(area_of(clip(ClipperLib::ctXor, got, want)), 1e-5) << area_of(got) << " vs " << area_of(want);
+      EXPECT_EQ(area_of(got) > 0.0, area_of(want) > 0.0);
+      (area_of(want) > 0.0 ? fitting : empty) += 1;
+    }
+  }
+  EXPECT_GE(fitting, 6) << "the cases must include fits";
+  EXPECT_GE(empty, 4) << "and candidates that do not fit";
 }
 
 TEST(NestFit, ConvexRoomHoldsAConcaveRingExactlyWhenItHoldsItsHull) {
