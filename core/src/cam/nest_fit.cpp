@@ -324,17 +324,16 @@ void no_fit_pieces(const Path& g, const Path& neg, const BoxWindow& window, Path
 // room it is a small patch, or nothing.
 Paths corners_fit(const Paths& room, const Path& c) {
   constexpr std::size_t kCorners = 16;
-  const Path hull = convex_hull(c);
-  std::vector<IntPoint> corners{c.front()};
-  for (std::size_t i = 0; i < std::min(kCorners, hull.size()); ++i)
-    corners.push_back(hull[i * hull.size() / std::min(kCorners, hull.size())]);
-  Paths where;
-  for (const IntPoint& q : corners) {
+  auto room_less = [&](const IntPoint& q) {
     Paths moved;
     for (const Path& r : room) moved.push_back(translated(r, {-q.X, -q.Y}));
-    where = q == c.front() && where.empty() ? std::move(moved) : boolean(ClipperLib::ctIntersection, where, moved);
-    if (where.empty()) break;
-  }
+    return moved;
+  };
+  Paths where = room_less(c.front());
+  const Path hull = convex_hull(c);
+  const std::size_t picked = std::min(kCorners, hull.size());
+  for (std::size_t i = 0; i < picked && !where.empty(); ++i)
+    where = boolean(ClipperLib::ctIntersection, where, room_less(hull[i * hull.size() / picked]));
   return where;
 }
 
