@@ -157,6 +157,7 @@ class HoleFiller {
       out_.hosted.push_back({host, in_host});
       hosted_[cand] = true;
       has_children_[host] = true;
+      if (params_.on_placed) params_.on_placed();
       for (Path& g : outer_rings(offset_mitre({translated(c.proxy, best->t)}, s + kSlackMm))) grown.push_back(std::move(g));
       real.push_back(placed);
       room_area = area_mm2(boolean(ClipperLib::ctDifference, room0, grown));

@@ -113,7 +113,10 @@ std::vector<PackedSheet> pack_matrix(std::span<const Part> parts, std::span<cons
   std::vector<SheetState> sheets;
   for (const Item& item : items_largest_first(parts, which))
     // fits_on_sheet guarantees one orientation fits an empty sheet; if not, the driver is told.
-    if (!packer.place(item, sheets)) unplaced.push_back(item.part);
+    if (!packer.place(item, sheets))
+      unplaced.push_back(item.part);
+    else if (params.on_placed)
+      params.on_placed();
   std::vector<PackedSheet> out;
   out.reserve(sheets.size());
   for (SheetState& s : sheets) out.push_back(std::move(s.packed));

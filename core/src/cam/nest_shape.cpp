@@ -164,7 +164,10 @@ std::vector<PackedSheet> pack_shape(std::span<const Part> parts, std::span<const
   ln::NestConfig<ln::NfpPlacer, ln::FirstFitSelection> cfg;
   Pile pile;
   configure_placer(cfg, params, bin, pile);
-  ln::nest(items, bin, 0, cfg);
+  // libnest2d says how many items remain after each one it packs.
+  ln::nest(items, bin, 0, cfg, ln::NestControl([&params](unsigned) {
+             if (params.on_placed) params.on_placed();
+           }));
 
   int bins = 0;
   for (const auto& it : items) bins = std::max(bins, it.binId() + 1);

@@ -106,7 +106,7 @@ Stock sized_stock(const Stock& stock, const MachineConfig& machine, std::vector<
 
 std::expected<CamResult, Error> plan_cam(const BevelPlan& plan, const Stock& stock, const CamSettings& settings,
                                          const std::string& title, std::vector<SheetShortage>* shortages,
-                                         const std::function<void(int, int)>& on_sheet) {
+                                         const std::function<void(int, int)>& on_step) {
   CamResult r;
   auto t0 = Clock::now();
   auto parts = make_parts(plan, settings.parts);
@@ -114,25 +114,38 @@ std::expected<CamResult, Error> plan_cam(const BevelPlan& plan, const Stock& sto
   r.parts = std::move(*parts);
   r.timing.parts = seconds_since(t0);
 
+  // The steps: each part placed, then each sheet cut. The Menger sponge's 399 parts nested for
+  // over a minute with the bar standing still (issue 22); the sheets are not known until the
+  // nesting ends, so the total counts one until then.
+  std::mutex progress;
+  int done = 0, total = static_cast<int>(r.parts.size()) + 1;
+  bool nesting = true;
+  auto step = [&] {
+    const std::lock_guard lock(progress);
+    ++done;
+    if (nesting) total = std::max(total, done + 1);  // a part placed again after a sheet kind ran out
+    if (on_step) on_step(done, total);
+  };
   t0 = Clock::now();
-  auto nest = nest_parts(r.parts, stock, settings.machine.nest, shortages);
+  NestParams nest_params = settings.machine.nest;
+  nest_params.on_placed = step;
+  auto nest = nest_parts(r.parts, stock, nest_params, shortages);
   if (!nest) return std::unexpected(nest.error());
   r.timing.nest = seconds_since(t0);
 
   // The sheets side by side (each its own toolpath, program and drawing; the sphere's four took
   // 0.45 s one after the other), then taken in sheet order: the first failing sheet's error, the
   // warnings as one after the other would say them (each once), the steps' times summed.
-  const std::size_t total = nest->sheets.size();
-  std::vector<std::optional<std::expected<SheetOutput, Error>>> outs(total);
-  std::vector<SheetLog> logs(total);
-  std::mutex progress;
-  int done = 0;
-  tbb::parallel_for(std::size_t{0}, total, [&](std::size_t i) {
+  const std::size_t sheet_count = nest->sheets.size();
+  std::vector<std::optional<std::expected<SheetOutput, Error>>> outs(sheet_count);
+  std::vector<SheetLog> logs(sheet_count);
+  nesting = false;
+  total = done + static_cast<int>(sheet_count);
+  tbb::parallel_for(std::size_t{0}, sheet_count, [&](std::size_t i) {
     outs[i] = cut_sheet(plan, r.parts, std::move(nest->sheets[i]), settings, title, logs[i]);
-    const std::lock_guard lock(progress);
-    if (on_sheet) on_sheet(++done, static_cast<int>(total));
+    step();
   });
-  for (std::size_t i = 0; i < total; ++i) {
+  for (std::size_t i = 0; i < sheet_count; ++i) {
     if (!*outs[i]) return std::unexpected(outs[i]->error());
     r.sheets.push_back(std::move(**outs[i]));
     for (std::string& w : logs[i].warnings)

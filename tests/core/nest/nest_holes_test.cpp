@@ -10,6 +10,7 @@
 #include <gtest/gtest-spi.h>
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <numbers>
@@ -400,6 +401,25 @@ TEST_P(NestHoles, SmallPartsGoInsideTheBigRing) {
   EXPECT_GT(b.sheets, a.sheets);
   std::printf("[%s] ring + 9 small parts on 230 x 230: %d sheet(s), utilisation %.3f with hole filling; %d, %.3f without\n",
               nest_method_name(GetParam()), a.sheets, a.mean_utilisation, b.sheets, b.mean_utilisation);
+}
+
+// The nest says as it goes how many parts it has placed: once for each, whether in a hole or on
+// a sheet (a plan's progress bar stood still through a minute of nesting, issue 22).
+TEST_P(NestHoles, EveryPartPlacedIsCountedOnceAsItIsPlaced) {
+  const std::vector<Part> parts = ring_and_small_parts();
+  for (const bool fill : {true, false}) {
+    SCOPED_TRACE(fill ? "hole filling" : "no hole filling");
+    NestParams params = with(GetParam(), fill);
+    params.parallel = true;
+    std::atomic<int> placed{0};
+    params.on_placed = [&] { ++placed; };
+    auto nest = nest_parts(parts, one_sheet_kind(3.0, 230, 230), params);
+    ASSERT_TRUE(nest) << nest.error().message;
+    std::size_t on_sheets = 0;
+    for (const NestedSheet& sheet : nest->sheets) on_sheets += sheet.placements.size();
+    ASSERT_EQ(on_sheets, parts.size());
+    EXPECT_EQ(placed.load(), static_cast<int>(parts.size()));
+  }
 }
 
 // Four rings with L-shapes: the children follow their hosts onto both sheets (the packer may turn a ring).

@@ -225,7 +225,9 @@ TEST(PlanJob, ProgressNamesEveryPhaseInOrderAndItsStepsGrow) {
   // a round before, and said "of 12", the bound, not what was asked).
   EXPECT_GE(layering_steps, static_cast<int>(r->layering.layers.size()));
   EXPECT_EQ(deviation_steps, 1) << "the chosen strategy only, unless compare_strategies";
-  EXPECT_EQ(sheet_steps, static_cast<int>(r->cam->sheets.size()));
+  // Each part as the nesting places it (the Menger sponge nested for a minute with the bar still),
+  // then each sheet's program.
+  EXPECT_EQ(sheet_steps, static_cast<int>(r->cam->parts.size() + r->cam->sheets.size()));
 }
 
 TEST(PlanJob, AnErrorSaysInWhichPhase) {

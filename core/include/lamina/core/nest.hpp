@@ -13,6 +13,7 @@
 
 #include <cstdint>
 #include <expected>
+#include <functional>
 #include <span>
 #include <string>
 #include <vector>
@@ -33,6 +34,11 @@ struct NestParams {
   // Put smaller parts inside the free holes (Part::free_holes_mm) of larger ones before packing,
   // at least spacing_mm from the hole's free ring and from each other (docs/nesting.md).
   bool fill_holes = true;
+  // Called once for each part placed, in a hole or on a sheet, as it is placed (the progress of a
+  // nest that takes minutes); from any thread, never two at once for one thickness, but the
+  // thicknesses nest side by side. A part placed on a sheet beyond the stock's count is placed
+  // again on the next kind of sheet, and counted again.
+  std::function<void()> on_placed;
 };
 
 struct Placement {

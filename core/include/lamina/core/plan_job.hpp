@@ -140,10 +140,12 @@ Stock sized_stock(const Stock& stock, const MachineConfig& machine, std::vector<
 
 // Parts, nesting, one toolpath, program and drawing per sheet. When the rack runs out of sheets
 // (ErrorCode::stock_exhausted), `shortages` (if given) says which thicknesses and how many of
-// their layers were placed whole. `on_sheet(done, total)` after each sheet's program.
+// their layers were placed whole. `on_step(done, total)` after each part the nesting places and
+// then each sheet's program (the total grows by the sheets once the nesting knows them); one call
+// at a time.
 std::expected<CamResult, Error> plan_cam(const BevelPlan& plan, const Stock& stock, const CamSettings& settings,
                                          const std::string& title, std::vector<SheetShortage>* shortages = nullptr,
-                                         const std::function<void(int, int)>& on_sheet = {});
+                                         const std::function<void(int, int)>& on_step = {});
 
 // The rack as the layering sees it (issue 17, item 5): one entry per thickness whose sheets have
 // a known size, the room a layer's outline has on each (the sheet less its margin on both sides
