@@ -178,14 +178,12 @@ void move_station(LayerOutline& outline, std::size_t s, double by_mm) {
   outline.max_deviation_mm = std::max(outline.max_deviation_mm, outline.stations[s].max_deviation_mm);
 }
 
-// How deep q lies inside the material (0 outside or on its boundary).
-double depth_inside(const Eigen::Vector2d& q, const ClipperLib::Paths& material) {
-  const ClipperLib::IntPoint p(static_cast<ClipperLib::cInt>(std::llround(q.x() * kClipperUnitsPerMm)),
-                               static_cast<ClipperLib::cInt>(std::llround(q.y() * kClipperUnitsPerMm)));
-  int winding = 0;
-  for (const ClipperLib::Path& path : material)
-    if (ClipperLib::PointInPolygon(p, path) == 1) winding += ClipperLib::Orientation(path) ? 1 : -1;
-  if (winding <= 0) return 0.0;
+// How deep q lies inside the material (0 outside). Whether it is inside at all comes from the
+// sub-slice's section lines (a grid: a moved station asks at every sub-slice and pass, and a
+// point-in-polygon test of every ring was 20 M corner visits per layer of the 1M sphere once its
+// stations were no longer the mesh's corners); only a point inside is measured.
+double depth_inside(const Eigen::Vector2d& q, const SectionLines& lines, const ClipperLib::Paths& material) {
+  if (!lines.contains(q)) return 0.0;
   double nearest = std::numeric_limits<double>::infinity();
   for (const ClipperLib::Path& path : material) {
     const std::vector<Eigen::Vector2d> ring = from_clipper(path);
@@ -201,14 +199,14 @@ double depth_inside(const Eigen::Vector2d& q, const ClipperLib::Paths& material)
 // strand of a knot beside it, another outline of the section): its lines are checked at every
 // sub-slice; a move that enters material is undone, and the gouge it was for stays reported.
 bool enters_material(const LayerOutline& outline, std::size_t s, const std::vector<const Slice*>& sub_slices,
-                     const std::vector<ClipperLib::Paths>& material) {
+                     const std::vector<SectionLines>& lines, const std::vector<ClipperLib::Paths>& material) {
   for (const CutPass& pass : outline.passes) {
     const CutLine& l = pass.lines[s];
     const double dz = l.top_mm.z() - l.bottom_mm.z();
     for (std::size_t j = 0; j < sub_slices.size(); ++j) {
       const double f = std::abs(dz) > 1e-12 ? (sub_slices[j]->z_mm - l.bottom_mm.z()) / dz : 0.0;
       const Eigen::Vector2d q = (l.bottom_mm + std::clamp(f, 0.0, 1.0) * (l.top_mm - l.bottom_mm)).head<2>();
-      if (depth_inside(q, material[j]) > kGougeTolerance) return true;
+      if (depth_inside(q, lines[j], material[j]) > kGougeTolerance) return true;
     }
   }
   return false;
@@ -216,7 +214,8 @@ bool enters_material(const LayerOutline& outline, std::size_t s, const std::vect
 
 }  // namespace
 
-GougeClearance clear_gouges(LayerPlan& layer, const std::vector<const Slice*>& sub_slices, double max_shift_mm) {
+GougeClearance clear_gouges(LayerPlan& layer, const std::vector<const Slice*>& sub_slices,
+                            const std::vector<SectionLines>& lines, double max_shift_mm) {
   GougeClearance r;
   std::vector<ClipperLib::Paths> material;
   material.reserve(sub_slices.size());
@@ -244,7 +243,7 @@ GougeClearance clear_gouges(LayerPlan& layer, const std::vector<const Slice*>& s
   }
   for (std::size_t o = 0; o < layer.outlines.size(); ++o) {
     for (std::size_t s = 0; s < moved[o].size(); ++s) {
-      if (moved[o][s] > 0.0 && enters_material(layer.outlines[o], s, sub_slices, material)) {
+      if (moved[o][s] > 0.0 && enters_material(layer.outlines[o], s, sub_slices, lines, material)) {
         move_station(layer.outlines[o], s, -moved[o][s]);
         ++r.moves_undone;
       }

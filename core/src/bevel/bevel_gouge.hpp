@@ -7,6 +7,7 @@
 // profiles were read from, and the two stations of a chord that cuts a corner are moved out
 // along their normals until no sub-slice material lies outside the layer's section.
 #include "lamina/core/bevel.hpp"
+#include "lamina/core/section_lines.hpp"
 #include "lamina/core/slice.hpp"
 
 #include <vector>
@@ -23,8 +24,10 @@ struct GougeClearance {
 
 // Moves lines of `layer` (outside cuts only) so that every sub-slice's material lies inside the
 // layer's section at the sub-slice's height, within kGougeTolerance; a station moves at most
-// max_shift_mm. Each moved station's max_deviation_mm grows by its shift.
-GougeClearance clear_gouges(LayerPlan& layer, const std::vector<const Slice*>& sub_slices, double max_shift_mm);
+// max_shift_mm. Each moved station's max_deviation_mm grows by its shift. `lines` are the
+// sub-slices' section lines, in the same order, built with their containment grid.
+GougeClearance clear_gouges(LayerPlan& layer, const std::vector<const Slice*>& sub_slices,
+                            const std::vector<SectionLines>& lines, double max_shift_mm);
 
 // Material deeper than this outside the cuts counts as a gouge (the Clipper grid is 1 nm, the
 // mesh is float).

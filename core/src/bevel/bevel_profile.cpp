@@ -303,6 +303,15 @@ class Fitter {
       double best = std::numeric_limits<double>::infinity();
       for (std::size_t i = 0; i + 1 < edge_pts.size(); ++i) best = std::min(best, dist_to_seg(p, edge_pts[i], edge_pts[i + 1]));
       if (edge_pts.size() == 1) best = dist_to_seg(p, edge_pts[0], edge_pts[0]);
+      // The layer's faces are its surface too: a sample inside the layer's material lies no
+      // farther from the layer than from its nearer face (what the 3-D measure of a layer reads,
+      // its closed shell, bevel_distance.cpp). Without them a sample near a face on a shallow
+      // slope measured its way along the face to the cut: the layering's estimates of the 1M
+      // sphere's sloped layers were 2.3 times their measures (0.266 against 0.117 mm), and the
+      // verification replanned the stack in five rounds.
+      double edge_u = std::numeric_limits<double>::infinity();
+      for (const Line& l : lines) edge_u = std::min(edge_u, l.at(p.z, zb_));
+      if (p.u <= edge_u) best = std::min({best, p.z - zb_, zt_ - p.z});
       worst = std::max(worst, best);
     }
     return worst;

@@ -1,6 +1,8 @@
 // No-fit and inner-fit regions with Clipper 6 (see nest_fit.hpp for why each formula is exact).
 #include "cam/nest_fit.hpp"
 
+#include "geometry/ring_simplify.hpp"
+
 #include <Eigen/Core>
 
 #include <algorithm>
@@ -82,85 +84,8 @@ bool is_convex(const Path& ring) {
   return true;
 }
 
-namespace {
-
-// Douglas–Peucker on a closed ring, keeping corner 0 and the corner farthest from it: every
-// dropped corner is within `tol` of the chord that replaces it.
-Path douglas_peucker(const Path& ring, double tol) {
-  const std::size_t n = ring.size();
-  auto dist2 = [&](std::size_t i, std::size_t j) {
-    const double dx = static_cast<double>(ring[i % n].X - ring[j % n].X);
-    const double dy = static_cast<double>(ring[i % n].Y - ring[j % n].Y);
-    return dx * dx + dy * dy;
-  };
-  std::size_t far = 0;
-  for (std::size_t i = 1; i < n; ++i)
-    if (dist2(i, 0) > dist2(far, 0)) far = i;
-  std::vector<bool> keep(n, false);
-  keep[0] = keep[far] = true;
-  std::vector<std::pair<std::size_t, std::size_t>> spans{{0, far}, {far, n}};  // corner n is corner 0
-  while (!spans.empty()) {
-    const auto [a, b] = spans.back();
-    spans.pop_back();
-    const IntPoint& pa = ring[a % n];
-    const double ex = static_cast<double>(ring[b % n].X - pa.X), ey = static_cast<double>(ring[b % n].Y - pa.Y);
-    const double len = std::hypot(ex, ey);
-    double worst = 0.0;
-    std::size_t at = a;
-    for (std::size_t i = a + 1; i < b; ++i) {
-      const double px = static_cast<double>(ring[i].X - pa.X), py = static_cast<double>(ring[i].Y - pa.Y);
-      // Distance to the segment (not the line), so a chord never strays past its span.
-      const double u = len > 0.0 ? std::clamp((px * ex + py * ey) / (len * len), 0.0, 1.0) : 0.0;
-      const double d = std::hypot(px - u * ex, py - u * ey);
-      if (d > worst) {
-        worst = d;
-        at = i;
-      }
-    }
-    if (worst <= tol) continue;
-    keep[at] = true;
-    spans.emplace_back(a, at);
-    spans.emplace_back(at, b);
-  }
-  Path out;
-  for (std::size_t i = 0; i < n; ++i)
-    if (keep[i]) out.push_back(ring[i]);
-  return out;
-}
-
-// A simple ring (Clipper finds no crossing to split) with the same area as `ring`, to the
-// doubles' rounding of the areas in nm² (a ring of R 80 mm is 2·10¹⁶ nm², whose step is 4).
-bool is_simple(const Path& ring) {
-  Paths parts;
-  ClipperLib::SimplifyPolygon(ring, parts, ClipperLib::pftNonZero);
-  if (parts.size() != 1) return false;
-  const double area = ClipperLib::Area(ring);
-  return std::abs(ClipperLib::Area(parts.front()) - area) <= std::max(1.0, 1e-12 * std::abs(area));
-}
-
-}  // namespace
-
-namespace {
-
-// The ring offset by `by_mm` (outwards when positive), mitred (every point of the offset ring at
-// least |by| from the ring), then chords within |by| / 2 of it: the chords stay ≥ |by| / 2 on
-// that side of the ring. The ring itself when that fails or saves nothing.
-Path simplified_beside(const Path& ring, double by_mm) {
-  const Paths moved = offset_mitre({ring}, by_mm);
-  if (moved.size() != 1 || !ClipperLib::Orientation(moved.front())) return ring;
-  Path out = douglas_peucker(moved.front(), 0.5 * std::abs(by_mm) * kClipperUnitsPerMm);
-  if (out.size() >= ring.size() || out.size() < 3 || !ClipperLib::Orientation(out) || !is_simple(out)) return ring;
-  // Belt and braces: the side must hold (else keep the ring itself).
-  const Paths wrong_side = by_mm > 0.0 ? boolean(ClipperLib::ctDifference, {ring}, {out})
-                                       : boolean(ClipperLib::ctDifference, {out}, {ring});
-  if (area_mm2(wrong_side) != 0.0) return ring;
-  return out;
-}
-
-}  // namespace
-
-Path simplified_outside(const Path& ring) { return simplified_beside(ring, kSimplifyMm); }
-Path simplified_inside(const Path& ring) { return simplified_beside(ring, -kSimplifyMm); }
+Path simplified_outside(const Path& ring) { return geometry_detail::simplified_beside(ring, kSimplifyMm); }
+Path simplified_inside(const Path& ring) { return geometry_detail::simplified_beside(ring, -kSimplifyMm); }
 
 Path outer_proxy(const Path& ring) {
   Path hull = convex_hull(ring);

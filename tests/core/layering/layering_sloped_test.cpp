@@ -79,10 +79,15 @@ TEST(LayeringSloped, ConeFlatterThanTheTiltLimitNeedsThinnerSheets) {
   ASSERT_TRUE(narrow.has_value());
   expect_well_formed(*narrow, p);
   EXPECT_TRUE(narrow->shortfalls.empty());
-  ASSERT_EQ(narrow->layers.size(), 20u) << "only 1 mm sheets stay within 0.6 mm at a 45° limit";
+  // Along the wall only 1 mm sheets keep the strip within 0.6 mm. The last layer holds the
+  // apex, where the wall ends inside it: a thicker sheet may stay within there (its plan
+  // measures 0.55 mm for 2.5 mm), and the stack is then a layer shorter.
+  ASSERT_GE(narrow->layers.size(), 19u) << "only 1 mm sheets stay within 0.6 mm at a 45° limit";
   double previous = 0.0;
-  for (const auto& l : narrow->layers) {
-    EXPECT_EQ(l.thickness_mm, 1.0);
+  for (std::size_t i = 0; i < narrow->layers.size(); ++i) {
+    const LayerSpan& l = narrow->layers[i];
+    if (i + 1 < narrow->layers.size()) EXPECT_EQ(l.thickness_mm, 1.0) << "layer " << i;
+    EXPECT_TRUE(l.within_tolerance) << "layer " << i;
     EXPECT_GT(l.estimated_deviation_mm, 0.2) << "the strip the limit leaves is seen";
     previous = std::max(previous, l.estimated_deviation_mm);
   }

@@ -88,6 +88,10 @@ struct BevelParams {
   ProfileFitParams fit;
   double sub_slice_mm = 0.5;        // spacing of the thin slices inside a layer (paper's thin layers)
   double station_spacing_mm = 1.0;  // outline edges longer than this get extra stations
+  // The layer outline, whose corners are stations, loses corners within this (Douglas–Peucker on
+  // the outline grown by it): its rings then stand between half and twice this off the material.
+  // 0 keeps every corner of the model's sections.
+  double outline_simplify_mm = 0.01;
   double tolerance_mm = 0.1;        // within_tolerance threshold for max_deviation_mm
   // Holes of a layer outline narrower than this (mean width 2·area/perimeter) stay closed: a
   // jet cannot cut them, and they are mostly slivers where sub-slices nearly coincide.

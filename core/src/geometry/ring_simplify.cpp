@@ -1,0 +1,135 @@
+// Rings with fewer corners on a chosen side (ring_simplify.hpp).
+#include "geometry/ring_simplify.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+#include <vector>
+
+namespace lamina::geometry_detail {
+using ClipperLib::IntPoint;
+using ClipperLib::Path;
+using ClipperLib::Paths;
+
+namespace {
+
+// Douglas–Peucker on the open chain of ring corners a..b (indices taken modulo the size), its
+// ends kept: marks the corners to keep.
+void simplify_chain(const Path& ring, std::size_t a, std::size_t b, double tol_units, std::vector<bool>& keep) {
+  const std::size_t n = ring.size();
+  std::vector<std::pair<std::size_t, std::size_t>> spans{{a, b}};
+  while (!spans.empty()) {
+    const auto [s, e] = spans.back();
+    spans.pop_back();
+    const IntPoint& ps = ring[s % n];
+    const double ex = static_cast<double>(ring[e % n].X - ps.X), ey = static_cast<double>(ring[e % n].Y - ps.Y);
+    const double len = std::hypot(ex, ey);
+    double worst = 0.0;
+    std::size_t at = s;
+    for (std::size_t i = s + 1; i < e; ++i) {
+      const double px = static_cast<double>(ring[i % n].X - ps.X), py = static_cast<double>(ring[i % n].Y - ps.Y);
+      // Distance to the segment (not the line), so a chord never strays past its span.
+      const double u = len > 0.0 ? std::clamp((px * ex + py * ey) / (len * len), 0.0, 1.0) : 0.0;
+      const double d = std::hypot(px - u * ex, py - u * ey);
+      if (d > worst) {
+        worst = d;
+        at = i;
+      }
+    }
+    if (worst <= tol_units) continue;
+    keep[at % n] = true;
+    spans.emplace_back(s, at);
+    spans.emplace_back(at, e);
+  }
+}
+
+// How far the ring turns at corner i (radians, either way).
+double turn_at(const Path& ring, std::size_t i) {
+  const std::size_t n = ring.size();
+  const IntPoint& p = ring[(i + n - 1) % n];
+  const IntPoint& q = ring[i];
+  const IntPoint& r = ring[(i + 1) % n];
+  const double ax = static_cast<double>(q.X - p.X), ay = static_cast<double>(q.Y - p.Y);
+  const double bx = static_cast<double>(r.X - q.X), by = static_cast<double>(r.Y - q.Y);
+  return std::abs(std::atan2(ax * by - ay * bx, ax * bx + ay * by));
+}
+
+}  // namespace
+
+Path douglas_peucker(const Path& ring, double tol_units, double keep_turn_rad) {
+  const std::size_t n = ring.size();
+  if (n < 3) return ring;
+  std::vector<bool> keep(n, false);
+  std::vector<std::size_t> kept;
+  for (std::size_t i = 0; i < n; ++i)
+    if (turn_at(ring, i) > keep_turn_rad) {
+      keep[i] = true;
+      kept.push_back(i);
+    }
+  if (kept.size() < 2) {  // corner 0 (or the one sharp corner) and the corner farthest from it
+    const std::size_t first = kept.empty() ? 0 : kept.front();
+    auto dist2 = [&](std::size_t i) {
+      const double dx = static_cast<double>(ring[i].X - ring[first].X);
+      const double dy = static_cast<double>(ring[i].Y - ring[first].Y);
+      return dx * dx + dy * dy;
+    };
+    std::size_t far = first;
+    for (std::size_t i = 0; i < n; ++i)
+      if (dist2(i) > dist2(far)) far = i;
+    keep[first] = keep[far] = true;
+    kept = {std::min(first, far), std::max(first, far)};
+  }
+  for (std::size_t k = 0; k < kept.size(); ++k) {
+    const std::size_t a = kept[k];
+    const std::size_t b = k + 1 < kept.size() ? kept[k + 1] : kept.front() + n;  // around the end
+    simplify_chain(ring, a, b, tol_units, keep);
+  }
+  Path out;
+  for (std::size_t i = 0; i < n; ++i)
+    if (keep[i]) out.push_back(ring[i]);
+  return out;
+}
+
+namespace {
+
+// A simple ring (Clipper finds no crossing to split) with the same area as `ring`, to the
+// doubles' rounding of the areas in nm² (a ring of R 80 mm is 2·10¹⁶ nm², whose step is 4).
+bool is_simple(const Path& ring) {
+  Paths parts;
+  ClipperLib::SimplifyPolygon(ring, parts, ClipperLib::pftNonZero);
+  if (parts.size() != 1) return false;
+  const double area = ClipperLib::Area(ring);
+  return std::abs(ClipperLib::Area(parts.front()) - area) <= std::max(1.0, 1e-12 * std::abs(area));
+}
+
+Paths offset_mitred(const Path& ring, double by_mm) {
+  ClipperLib::ClipperOffset off;  // MiterLimit 2: squared beyond, the square's edge at |by|
+  off.AddPath(ring, ClipperLib::jtMiter, ClipperLib::etClosedPolygon);
+  Paths out;
+  off.Execute(out, by_mm * kClipperUnitsPerMm);
+  return out;
+}
+
+double difference_area(const Path& a, const Path& b) {
+  ClipperLib::Clipper c;
+  c.AddPath(a, ClipperLib::ptSubject, true);
+  c.AddPath(b, ClipperLib::ptClip, true);
+  Paths out;
+  c.Execute(ClipperLib::ctDifference, out, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
+  return area_mm2(out);
+}
+
+}  // namespace
+
+Path simplified_beside(const Path& ring, double by_mm, double keep_turn_rad) {
+  const Paths moved = offset_mitred(ring, by_mm);
+  if (moved.size() != 1 || !ClipperLib::Orientation(moved.front())) return ring;
+  Path out = douglas_peucker(moved.front(), 0.5 * std::abs(by_mm) * kClipperUnitsPerMm, keep_turn_rad);
+  if (out.size() >= ring.size() || out.size() < 3 || !ClipperLib::Orientation(out) || !is_simple(out)) return ring;
+  // Belt and braces: the side must hold (else keep the ring itself).
+  const double wrong_side = by_mm > 0.0 ? difference_area(ring, out) : difference_area(out, ring);
+  if (wrong_side != 0.0) return ring;
+  return out;
+}
+
+}  // namespace lamina::geometry_detail
