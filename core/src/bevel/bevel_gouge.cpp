@@ -129,9 +129,15 @@ class ChordIndex {
 
 // Finds material of the sub-slices outside the layer's section; for each piece's vertices the
 // chord they lie beyond and how far each of its stations must move out. Returns the deepest.
-double find_gouges(const LayerPlan& layer, const std::vector<const Slice*>& sub_slices,
-                   const std::vector<ClipperLib::Paths>& material, std::vector<std::vector<double>>* shift) {
+struct Gouges {
   double worst = 0.0;
+  double worst_marked = 0.0;  // on chords `marked` says
+};
+
+Gouges find_gouges(const LayerPlan& layer, const std::vector<const Slice*>& sub_slices,
+                   const std::vector<ClipperLib::Paths>& material, std::vector<std::vector<double>>* shift,
+                   const std::vector<std::vector<char>>* marked = nullptr) {
+  Gouges worst;
   for (std::size_t j = 0; j < sub_slices.size(); ++j) {
     const double z = sub_slices[j]->z_mm;
     ClipperLib::Clipper c;
@@ -152,7 +158,11 @@ double find_gouges(const LayerPlan& layer, const std::vector<const Slice*>& sub_
         const Eigen::Vector2d scrap(dir.y(), -dir.x());
         const double depth = (q - ch->pa).dot(scrap);
         if (depth <= kGougeTolerance) continue;  // not beyond this chord: nothing a move here mends
-        worst = std::max(worst, depth);
+        worst.worst = std::max(worst.worst, depth);
+        if (marked) {
+          const auto& m = (*marked)[static_cast<std::size_t>(ch->outline)];
+          if (ch->a < m.size() && m[ch->a]) worst.worst_marked = std::max(worst.worst_marked, depth);
+        }
         if (!shift) continue;
         const LayerOutline& outline = layer.outlines[static_cast<std::size_t>(ch->outline)];
         const double rate = std::max(kMinChordRate, std::min(outline.stations[ch->a].normal.dot(scrap),
@@ -215,7 +225,8 @@ bool enters_material(const LayerOutline& outline, std::size_t s, const std::vect
 }  // namespace
 
 GougeClearance clear_gouges(LayerPlan& layer, const std::vector<const Slice*>& sub_slices,
-                            const std::vector<SectionLines>& lines, double max_shift_mm) {
+                            const std::vector<SectionLines>& lines, double max_shift_mm,
+                            const std::vector<std::vector<char>>* marked) {
   GougeClearance r;
   std::vector<ClipperLib::Paths> material;
   material.reserve(sub_slices.size());
@@ -225,8 +236,11 @@ GougeClearance clear_gouges(LayerPlan& layer, const std::vector<const Slice*>& s
   for (std::size_t o = 0; o < layer.outlines.size(); ++o) moved[o].assign(layer.outlines[o].stations.size(), 0.0);
   for (int round = 0; round < kRounds; ++round) {
     for (std::size_t o = 0; o < layer.outlines.size(); ++o) shift[o].assign(layer.outlines[o].stations.size(), 0.0);
-    const double worst = find_gouges(layer, sub_slices, material, &shift);
-    if (round == 0) r.worst_found_mm = worst;
+    const Gouges found = find_gouges(layer, sub_slices, material, &shift, round == 0 ? marked : nullptr);
+    if (round == 0) {
+      r.worst_found_mm = found.worst;
+      r.worst_found_loose_mm = found.worst_marked;
+    }
     bool any = false;
     for (std::size_t o = 0; o < layer.outlines.size(); ++o) {
       for (std::size_t s = 0; s < shift[o].size(); ++s) {
@@ -249,7 +263,7 @@ GougeClearance clear_gouges(LayerPlan& layer, const std::vector<const Slice*>& s
       }
     }
   }
-  r.worst_left_mm = r.stations_moved > 0 ? find_gouges(layer, sub_slices, material, nullptr) : r.worst_found_mm;
+  r.worst_left_mm = r.stations_moved > 0 ? find_gouges(layer, sub_slices, material, nullptr).worst : r.worst_found_mm;
   for (const LayerOutline& outline : layer.outlines)
     layer.max_deviation_mm = std::max(layer.max_deviation_mm, outline.max_deviation_mm);
   return r;

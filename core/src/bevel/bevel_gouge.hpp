@@ -20,14 +20,20 @@ struct GougeClearance {
   int stations_moved = 0;
   double largest_shift_mm = 0.0;
   int moves_undone = 0;  // moves that would have entered other material (left as they were)
+  // The deepest found before clearing on a chord between two stations the caller marks (0 when
+  // it marks none).
+  double worst_found_loose_mm = 0.0;
 };
 
 // Moves lines of `layer` (outside cuts only) so that every sub-slice's material lies inside the
 // layer's section at the sub-slice's height, within kGougeTolerance; a station moves at most
 // max_shift_mm. Each moved station's max_deviation_mm grows by its shift. `lines` are the
-// sub-slices' section lines, in the same order, built with their containment grid.
+// sub-slices' section lines, in the same order, built with their containment grid. `marked`
+// (per outline, per station: the chord to the next station) chooses the chords whose gouges
+// worst_found_loose_mm reports.
 GougeClearance clear_gouges(LayerPlan& layer, const std::vector<const Slice*>& sub_slices,
-                            const std::vector<SectionLines>& lines, double max_shift_mm);
+                            const std::vector<SectionLines>& lines, double max_shift_mm,
+                            const std::vector<std::vector<char>>* marked = nullptr);
 
 // Material deeper than this outside the cuts counts as a gouge (the Clipper grid is 1 nm, the
 // mesh is float).

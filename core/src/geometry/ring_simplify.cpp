@@ -56,9 +56,11 @@ double turn_at(const Path& ring, std::size_t i) {
 
 }  // namespace
 
-Path douglas_peucker(const Path& ring, double tol_units, double keep_turn_rad) {
+namespace {
+
+// The corners Douglas–Peucker keeps (douglas_peucker below).
+std::vector<bool> corners_kept(const Path& ring, double tol_units, double keep_turn_rad) {
   const std::size_t n = ring.size();
-  if (n < 3) return ring;
   std::vector<bool> keep(n, false);
   std::vector<std::size_t> kept;
   for (std::size_t i = 0; i < n; ++i)
@@ -84,10 +86,24 @@ Path douglas_peucker(const Path& ring, double tol_units, double keep_turn_rad) {
     const std::size_t b = k + 1 < kept.size() ? kept[k + 1] : kept.front() + n;  // around the end
     simplify_chain(ring, a, b, tol_units, keep);
   }
-  Path out;
-  for (std::size_t i = 0; i < n; ++i)
-    if (keep[i]) out.push_back(ring[i]);
+  return keep;
+}
+
+// The kept corners as a ring, and which of its edges replaced dropped corners.
+SimplifiedRing kept_ring(const Path& ring, const std::vector<bool>& keep) {
+  SimplifiedRing out;
+  for (std::size_t i = 0; i < ring.size(); ++i)
+    if (keep[i]) out.ring.push_back(ring[i]);
+  for (std::size_t i = 0; i < ring.size(); ++i)
+    if (keep[i]) out.chord.push_back(keep[(i + 1) % ring.size()] ? 0 : 1);
   return out;
+}
+
+}  // namespace
+
+Path douglas_peucker(const Path& ring, double tol_units, double keep_turn_rad) {
+  if (ring.size() < 3) return ring;
+  return kept_ring(ring, corners_kept(ring, tol_units, keep_turn_rad)).ring;
 }
 
 namespace {
@@ -121,15 +137,22 @@ double difference_area(const Path& a, const Path& b) {
 
 }  // namespace
 
-Path simplified_beside(const Path& ring, double by_mm, double keep_turn_rad) {
+SimplifiedRing simplified_beside_marked(const Path& ring, double by_mm, double keep_turn_rad) {
+  const SimplifiedRing unchanged{ring, std::vector<char>(ring.size(), 0)};
   const Paths moved = offset_mitred(ring, by_mm);
-  if (moved.size() != 1 || !ClipperLib::Orientation(moved.front())) return ring;
-  Path out = douglas_peucker(moved.front(), 0.5 * std::abs(by_mm) * kClipperUnitsPerMm, keep_turn_rad);
-  if (out.size() >= ring.size() || out.size() < 3 || !ClipperLib::Orientation(out) || !is_simple(out)) return ring;
+  if (moved.size() != 1 || !ClipperLib::Orientation(moved.front())) return unchanged;
+  const Path& around = moved.front();
+  SimplifiedRing out = kept_ring(around, corners_kept(around, 0.5 * std::abs(by_mm) * kClipperUnitsPerMm, keep_turn_rad));
+  const Path& r = out.ring;
+  if (r.size() >= ring.size() || r.size() < 3 || !ClipperLib::Orientation(r) || !is_simple(r)) return unchanged;
   // Belt and braces: the side must hold (else keep the ring itself).
-  const double wrong_side = by_mm > 0.0 ? difference_area(ring, out) : difference_area(out, ring);
-  if (wrong_side != 0.0) return ring;
+  const double wrong_side = by_mm > 0.0 ? difference_area(ring, r) : difference_area(r, ring);
+  if (wrong_side != 0.0) return unchanged;
   return out;
+}
+
+Path simplified_beside(const Path& ring, double by_mm, double keep_turn_rad) {
+  return simplified_beside_marked(ring, by_mm, keep_turn_rad).ring;
 }
 
 }  // namespace lamina::geometry_detail

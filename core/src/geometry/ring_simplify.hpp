@@ -5,6 +5,7 @@
 #include "geometry/clipper_bridge.hpp"
 
 #include <numbers>
+#include <vector>
 
 namespace lamina::geometry_detail {
 
@@ -19,5 +20,13 @@ ClipperLib::Path douglas_peucker(const ClipperLib::Path& ring, double tol_units,
 // Corners of the offset ring that turn by more than keep_turn_rad stay. The ring itself when that
 // fails (it splits, is not simple) or saves no corner.
 ClipperLib::Path simplified_beside(const ClipperLib::Path& ring, double by_mm, double keep_turn_rad = std::numbers::pi);
+
+// The same, saying which of its edges are chords that replaced corners: chord[i] for the edge
+// from corner i to i + 1 (all 0 when the ring itself comes back).
+struct SimplifiedRing {
+  ClipperLib::Path ring;
+  std::vector<char> chord;
+};
+SimplifiedRing simplified_beside_marked(const ClipperLib::Path& ring, double by_mm, double keep_turn_rad);
 
 }  // namespace lamina::geometry_detail

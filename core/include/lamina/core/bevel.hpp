@@ -78,6 +78,9 @@ struct LayerPlan {
   // material still outside the cuts afterwards (0 when all was cleared). Both mm.
   double gouge_shift_mm = 0.0;
   double gouge_left_mm = 0.0;
+  // The outline lost corners to BevelParams::outline_simplify_mm (its stations are fewer than
+  // the sections' corners).
+  bool outline_simplified = false;
   // Stations per shape, indexed by ProfileShape.
   std::array<int, 5> shape_counts{};
 
