@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <functional>
+#include <numbers>
 
 namespace lamina {
 namespace {
@@ -157,6 +158,26 @@ TEST(ProfileFit, MixedSideStraddlesTheSurface) {
   EXPECT_LT(lo, 0);
   EXPECT_GT(hi, 0);
   EXPECT_NEAR(-lo, hi, 1e-9);
+}
+
+TEST(ProfileFit, ASampleInsideTheLayerIsAsNearAsTheFaceNextToIt) {
+  // A surface 68° from vertical, u = −2.5 (1 − z) over a 1 mm layer, and a 45° limit: the one
+  // line the limit allows runs from (z 0, u −1) to (z 1, u 0). The layer's edge is that line and
+  // its two faces (what the 3-D measure of a layer reads, its closed shell): the sample at the
+  // bottom face, 1.5 mm in from the line's end, lies on the layer's bottom face. The farthest is
+  // the line's bottom end from the surface, 1.5 / √(1 + 2.5²) = 0.557 mm; along the face to the
+  // line's end it read 1.5 mm, and the layering's estimates on the 1M sphere's slopes were 2.3
+  // times the layers' measures.
+  const Curve shallow = [](double z) { return -2.5 * (1.0 - z); };
+  const auto s = sample(shallow, 0, 1, 0.25);
+  ProfileFitParams p;
+  p.tilt_max_rad = std::numbers::pi / 4;
+  const auto fit = fit_profile(s, 0, 1, p);
+  ASSERT_EQ(fit.cuts.size(), 1u);
+  EXPECT_TRUE(fit.tilt_limited);
+  EXPECT_NEAR(fit.cuts[0].u_bottom_mm, -1.0, 1e-9);
+  EXPECT_NEAR(fit.cuts[0].u_top_mm, 0.0, 1e-9);
+  EXPECT_NEAR(fit.max_deviation_mm, 1.5 / std::sqrt(1.0 + 2.5 * 2.5), 1e-6);
 }
 
 TEST(ProfileFit, MissingSamplesMakeALedge) {
