@@ -38,17 +38,6 @@ struct Node {
 
 std::int64_t key_of(double z) { return std::llround(z / kPositionQuantum); }
 
-// A layer's deviation as the tie-break between stacks of as many layers counts it: in steps of
-// a twentieth of the tolerance, rounded up. Finer differences are no better part (0.0016 against
-// 0.0031 mm at a 0.2 mm tolerance), and chasing them made the verification plan a new layout in
-// every round: the estimates of layers far within tolerance are a micrometre or two optimistic
-// against the plans' measures (the chords between stations), so the DP kept preferring the
-// layers not yet measured (the 1M sphere: 12 rounds, 115 layers planned instead of 29).
-double significant(double deviation_mm, double tolerance_mm) {
-  const double step = tolerance_mm / 20.0;
-  return step > 0.0 ? std::ceil(deviation_mm / step - 1e-9) * step : deviation_mm;
-}
-
 // Is (failed, count, deviation, last thickness) better than the node's?
 bool better(const Node& cand, const Node& cur, const std::vector<double>& t) {
   if (cand.failed != cur.failed) return cand.failed < cur.failed;
@@ -150,7 +139,7 @@ LayerChoice layer_optimal(Estimator& est, const LayeringParams& params) {
       Node next;
       next.failed = cur.failed + (ok ? 0 : 1);
       next.count = cur.count + 1;
-      next.deviation = cur.deviation + significant(d, tol);
+      next.deviation = cur.deviation + d;
       next.pred = it->first;
       next.layer = ChosenLayer{cur.z, static_cast<int>(i), d, ok, any};
       next.z = r.ends[i].final ? top : top + params.bond_mm;
