@@ -5,9 +5,9 @@
 
 #include "bevel/plan_layers.hpp"
 #include "bevel/bevel_gouge.hpp"
+#include "bevel/bevel_outline.hpp"
 #include "bevel/facets_by_z.hpp"
 #include "geometry/clipper_bridge.hpp"
-#include "geometry/ring_simplify.hpp"
 #include "lamina/core/section_lines.hpp"
 #include "lamina/core/slice.hpp"
 
@@ -36,15 +36,11 @@ std::vector<double> sub_slice_heights(double z_bottom_mm, double thickness_mm, d
 }
 
 namespace {
-
-struct OutlineRing {
-  Polygon2 points;
-  bool is_hole = false;
-  int parent = -1;
-  // Per corner: the edge to the next corner is a chord the simplification put in place of
-  // corners (empty: none was).
-  std::vector<char> chord;
-};
+using bevel_detail::layer_outline_rings;
+using bevel_detail::outline_section;
+using bevel_detail::OutlineRing;
+using bevel_detail::station_seeds;
+using bevel_detail::StationSeed;
 
 // Material that lies between two sub-slices and outside both: a bore's underside, the top of a
 // dome, a step — where the surface turns (nearly) horizontal between two thin slices. Such a
@@ -225,136 +221,6 @@ class SlabFacets {
   mutable std::uint32_t generation_ = 0;
 };
 
-// The union of every sub-slice's material and the shadows between them: what a vertical
-// outside cut keeps. Outer rings CCW, holes CW, holes linked to their outer ring.
-// A ring of the outline with fewer corners, `by_mm` off the material (outer rings grow, holes
-// shrink), or the ring itself: a finely tessellated model (the 1M sphere, 1000 corners per
-// ring) would otherwise get a station at every corner, 0.3 mm apart, while the profile between
-// stations spaced by station_spacing_mm is what the cut follows. Off the material, every
-// sub-slice's crossing lies inside the outline, where a station's line looks for it.
-//
-// Corners that turn by more than kKeepTurnRad stay stations: where a sub-slice's sharp corner
-// stands a little off its neighbours' (a twisted prism's tips, 0.37 mm apart and 2 µm off the
-// chord between the outer two), the chord between the stations either side cut the middle tip
-// and the gouge clearing moved them out 0.28 mm.
-constexpr double kKeepTurnRad = 15.0 * M_PI / 180.0;
-
-//
-// A ring that would keep more than kWorthSimplifying of its corners is kept whole: it saves
-// little planning for a plan that differs (openscad_example006's rings lost 0.2 % of their
-// corners).
-constexpr double kWorthSimplifying = 0.75;
-
-geometry_detail::SimplifiedRing simplified_off_material(const ClipperLib::Path& path, double by_mm) {
-  const geometry_detail::SimplifiedRing whole{path, {}};
-  if (!(by_mm > 0.0)) return whole;
-  geometry_detail::SimplifiedRing out;
-  if (ClipperLib::Orientation(path)) {
-    out = geometry_detail::simplified_beside_marked(path, by_mm, kKeepTurnRad);
-  } else {  // material outside it: the hole itself, inwards, and back in the hole's direction
-    const ClipperLib::Path hole(path.rbegin(), path.rend());
-    const geometry_detail::SimplifiedRing in = geometry_detail::simplified_beside_marked(hole, -by_mm, kKeepTurnRad);
-    const std::size_t m = in.ring.size();
-    out.ring.assign(in.ring.rbegin(), in.ring.rend());
-    out.chord.resize(m);
-    for (std::size_t j = 0; j < m; ++j) out.chord[j] = in.chord[(2 * m - 2 - j) % m];  // edge j is in's m-2-j reversed
-  }
-  if (static_cast<double>(out.ring.size()) > kWorthSimplifying * static_cast<double>(path.size())) return whole;
-  return out;
-}
-
-std::vector<OutlineRing> layer_outline_rings(const std::vector<const Slice*>& sub_slices, ClipperLib::Paths all,
-                                             double min_hole_width_mm, double simplify_mm, bool& simplified) {
-  for (const Slice* s : sub_slices) {
-    for (const Loop& l : s->loops) all.push_back(geometry_detail::to_clipper(l.points));
-  }
-  ClipperLib::Clipper clipper;
-  clipper.AddPaths(all, ClipperLib::ptSubject, true);
-  ClipperLib::PolyTree tree;
-  clipper.Execute(ClipperLib::ctUnion, tree, ClipperLib::pftPositive, ClipperLib::pftPositive);
-  std::vector<OutlineRing> rings;
-  // Drop vertices closer than 0.1 µm and collinear runs: unions of near-identical sub-slices
-  // leave such crumbs, and every vertex becomes a station.
-  auto add = [&](const ClipperLib::PolyNode& node, int parent) {
-    ClipperLib::Path path = node.Contour;
-    ClipperLib::CleanPolygon(path, 100.0);
-    if (path.size() < 3) return -1;
-    geometry_detail::SimplifiedRing fewer = simplified_off_material(path, simplify_mm);
-    simplified = simplified || fewer.ring.size() != path.size();
-    OutlineRing r;
-    r.points = geometry_detail::from_clipper(fewer.ring);
-    if (fewer.ring.size() != path.size()) r.chord = std::move(fewer.chord);
-    r.is_hole = node.IsHole();
-    r.parent = parent;
-    const double area = std::abs(signed_area_mm2(r.points));
-    if (area < 1e-8) return -1;
-    if (r.is_hole) {
-      // Mean width of the hole (2·area / perimeter): slivers between sub-slices that no jet can
-      // cut are left closed — keeping material there is on the safe side of "outside".
-      double perimeter = 0.0;
-      for (std::size_t i = 0; i < r.points.size(); ++i) perimeter += (r.points[(i + 1) % r.points.size()] - r.points[i]).norm();
-      if (2.0 * area / perimeter < min_hole_width_mm) return -2;
-    }
-    rings.push_back(std::move(r));
-    return static_cast<int>(rings.size()) - 1;
-  };
-  std::vector<std::pair<const ClipperLib::PolyNode*, int>> stack;
-  for (const ClipperLib::PolyNode* child : tree.Childs) stack.emplace_back(child, -1);
-  while (!stack.empty()) {
-    auto [node, parent] = stack.back();
-    stack.pop_back();
-    const int self = add(*node, node->IsHole() ? parent : -1);
-    if (self == -2) continue;  // a closed sliver: what lies inside it is inside the material
-    // Holes belong to the outer above them; islands inside a hole are new outers.
-    for (const ClipperLib::PolyNode* child : node->Childs) stack.emplace_back(child, node->IsHole() ? -1 : self);
-  }
-  return rings;
-}
-
-struct StationSeed {
-  Eigen::Vector2d point, normal;
-  // The cut from this station to the next runs along a chord of the outline's simplification,
-  // and neither station is a sharp corner: a gouge there may be the simplification's.
-  bool loose = false;
-};
-
-bool sharp_corner(const Polygon2& ring, std::size_t i) {
-  const std::size_t n = ring.size();
-  const Eigen::Vector2d a = ring[i] - ring[(i + n - 1) % n], b = ring[(i + 1) % n] - ring[i];
-  return std::abs(std::atan2(a.x() * b.y() - a.y() * b.x(), a.dot(b))) > kKeepTurnRad;
-}
-
-// Stations: every ring vertex (normal: bisector of its edges' normals) and extra points on edges
-// longer than the spacing (normal: the edge's). Normals point out of the material for outer and
-// hole rings alike (material is on the left of the ring's direction).
-std::vector<StationSeed> station_seeds(const OutlineRing& outline, double spacing_mm) {
-  const Polygon2& ring = outline.points;
-  const std::size_t n = ring.size();
-  std::vector<Eigen::Vector2d> edge_normal(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    const Eigen::Vector2d e = ring[(i + 1) % n] - ring[i];
-    const double len = e.norm();
-    edge_normal[i] = len > 0 ? Eigen::Vector2d(e.y() / len, -e.x() / len) : Eigen::Vector2d::Zero();
-  }
-  std::vector<StationSeed> seeds;
-  seeds.reserve(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    Eigen::Vector2d nrm = edge_normal[(i + n - 1) % n] + edge_normal[i];
-    nrm = nrm.norm() > 1e-12 ? nrm.normalized() : edge_normal[i];
-    const Eigen::Vector2d a = ring[i], b = ring[(i + 1) % n];
-    const double len = (b - a).norm();
-    const int extra = spacing_mm > 0 ? static_cast<int>(std::ceil(len / spacing_mm)) - 1 : 0;
-    const bool chord = !outline.chord.empty() && outline.chord[i];
-    const bool ends_sharp = chord && sharp_corner(ring, (i + 1) % n);
-    seeds.push_back({ring[i], nrm, chord && !sharp_corner(ring, i) && (extra > 0 || !ends_sharp)});
-    for (int k = 1; k <= extra; ++k) {
-      const double t = static_cast<double>(k) / (extra + 1);
-      seeds.push_back({a + t * (b - a), edge_normal[i], chord && (k < extra || !ends_sharp)});
-    }
-  }
-  return seeds;
-}
-
 double wrap_near(double angle, double reference) {
   // The representative of angle (mod 2π) closest to reference: C never jumps by a turn.
   const double two_pi = 2.0 * M_PI;
@@ -396,20 +262,6 @@ void unwind_c(CutPass& pass) {
       reference = l.c_rad;
     }
   }
-}
-
-// The outline as a section, to find how far out a line may go before it meets other material
-// of the same layer.
-Slice outline_section(const std::vector<OutlineRing>& rings) {
-  Slice outline_slice;
-  for (const OutlineRing& ring : rings) {
-    Loop loop;
-    loop.points = ring.points;
-    loop.facets.assign(ring.points.size(), -1);
-    loop.area_mm2 = signed_area_mm2(ring.points);
-    outline_slice.loops.push_back(std::move(loop));
-  }
-  return outline_slice;
 }
 
 // The outline here comes from material between sub-slices (a shadow), which the profile cannot

@@ -23,7 +23,7 @@ namespace lamina {
 
 namespace {
 
-std::unexpected<Error> bad(std::string message) {
+std::unexpected<Error> invalid_input(std::string message) {
   return std::unexpected(Error{ErrorCode::invalid_argument, std::move(message)});
 }
 
@@ -50,18 +50,18 @@ std::expected<void, Error> check_plan(const BevelPlan& plan) {
   for (std::size_t l = 0; l < plan.layers.size(); ++l) {
     const LayerPlan& layer = plan.layers[l];
     if (!std::isfinite(layer.z_bottom_mm) || !(layer.thickness_mm > 0.0) || !std::isfinite(layer.thickness_mm))
-      return bad(fmt::format("measure_deviation: layer {} has z_bottom {} and thickness {} (need finite, thickness > 0)",
+      return invalid_input(fmt::format("measure_deviation: layer {} has z_bottom {} and thickness {} (need finite, thickness > 0)",
                              l, layer.z_bottom_mm, layer.thickness_mm));
     for (std::size_t o = 0; o < layer.outlines.size(); ++o) {
       const LayerOutline& outline = layer.outlines[o];
       if (!geometry_detail::outline_usable(outline))
-        return bad(fmt::format("measure_deviation: layer {} outline {} is not usable ({} stations, {} passes; need "
+        return invalid_input(fmt::format("measure_deviation: layer {} outline {} is not usable ({} stations, {} passes; need "
                                ">= 3 stations, one line per station in every pass, finite points)",
                                l, o, outline.stations.size(), outline.passes.size()));
       any = any || !outline.is_hole;
     }
   }
-  if (!any) return bad("measure_deviation: the plan has no outline (no stack to compare)");
+  if (!any) return invalid_input("measure_deviation: the plan has no outline (no stack to compare)");
   return {};
 }
 
@@ -144,7 +144,7 @@ std::expected<Sections, Error> sections_of(const Mesh& mesh, const BevelPlan& pl
   }
   const double steps = std::ceil((z_hi - z_lo) / step_mm);
   if (steps > kMaxDeviationSections)
-    return bad(fmt::format("measure_deviation: {:.4g} mm at step {} mm is more than {:.0f} sections", z_hi - z_lo,
+    return invalid_input(fmt::format("measure_deviation: {:.4g} mm at step {} mm is more than {:.0f} sections", z_hi - z_lo,
                            step_mm, kMaxDeviationSections));
   const auto n_steps = std::max<std::size_t>(1, static_cast<std::size_t>(steps));
   std::vector<double> breaks;
@@ -169,9 +169,9 @@ std::expected<Sections, Error> sections_of(const Mesh& mesh, const BevelPlan& pl
 
 std::expected<void, Error> check_deviation_params(const DeviationParams& params) {
   if (!(params.step_mm > 0.0) || !std::isfinite(params.step_mm))
-    return bad(fmt::format("measure_deviation: step_mm must be finite and > 0 (got {})", params.step_mm));
+    return invalid_input(fmt::format("measure_deviation: step_mm must be finite and > 0 (got {})", params.step_mm));
   if (!(params.distance_sample_mm > 0.0) || !std::isfinite(params.distance_sample_mm))
-    return bad(fmt::format("measure_deviation: distance_sample_mm must be finite and > 0 (got {})",
+    return invalid_input(fmt::format("measure_deviation: distance_sample_mm must be finite and > 0 (got {})",
                            params.distance_sample_mm));
   return {};
 }
@@ -186,7 +186,7 @@ std::expected<Deviation, Error> measure_deviation(const Mesh& mesh, const BevelP
   if (auto ok = check_plan(plan); !ok) return std::unexpected(ok.error());
   constexpr double kMaxWallSamples = 5e7;
   if (const double samples = wall_sample_estimate(plan, params.distance_sample_mm); samples > kMaxWallSamples)
-    return bad(fmt::format("measure_deviation: distance_sample_mm {} would take {:.3g} wall samples (more than {:.0e})",
+    return invalid_input(fmt::format("measure_deviation: distance_sample_mm {} would take {:.3g} wall samples (more than {:.0e})",
                            params.distance_sample_mm, samples, kMaxWallSamples));
   auto sections = sections_of(mesh, plan, params.step_mm);
   if (!sections) return std::unexpected(sections.error());
