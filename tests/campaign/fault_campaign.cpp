@@ -44,7 +44,7 @@ struct Options {
 // One run's cell: the simulator, a small disk for the state folder when the fault needs one,
 // the daemon, a client.
 struct Rig {
-  explicit Rig(double time_scale, bool small_disk) : cell({}, time_scale) {
+  explicit Rig(double time_scale, bool small_disk) : cell({}, time_scale, kKillWatchdogMs) {
     if (small_disk) disk = std::make_unique<SmallDisk>(cell.dir.file("state"), "48m");
     daemon = std::make_unique<Laminad>(cell.config(), cell.dir.file(""));
     reconnect();

@@ -38,15 +38,24 @@ inline double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
+// The PLC's heartbeat watchdog (wall ms) for tests that kill the daemon or stand the machine
+// without it and count on the PLC to close the jet and hold the CNC at once (the recovery tests,
+// the fault campaign's 250 ms standstill limit).
+inline constexpr int kKillWatchdogMs = 1000;
+// For every other test: 5 s. The daemon beats every 0.2 s, and at 1 s a sanitized daemon on a
+// loaded 2-core machine missed it once: the job paused on "PLC alarm 2 (heartbeat watchdog)
+// latched" in the middle of a test about cutting sheets.
+inline constexpr int kWatchdogMs = 5000;
+
 // The simulated cell, fast: 20× time, 921600 baud (the link is not what these tests measure),
 // paced to the host (--pace-to-host): real time while the daemon falls behind, so a sanitized
 // daemon's pause on a loaded machine is not taken for a daemon too slow for a real one.
 struct Cell {
-  explicit Cell(std::vector<std::string> extra = {}, double time_scale = 20)
+  explicit Cell(std::vector<std::string> extra = {}, double time_scale = 20, int watchdog_ms = kWatchdogMs)
       : sim([&] {
           std::vector<std::string> args{"--link", dir.file("cnc"), "--modbus", "127.0.0.1:0", "--control", "127.0.0.1:0",
                                         "--log", dir.file("exec.jsonl"), "--pressure-ramp", "0.2", "--baud", "921600",
-                                        "--time-scale", fmt::format("{}", time_scale), "--pace-to-host", "--heartbeat-timeout", "1000",
+                                        "--time-scale", fmt::format("{}", time_scale), "--pace-to-host", "--heartbeat-timeout", std::to_string(watchdog_ms),
                                         "--machine", std::string(LAMINA_SOURCE_DIR) + "/config/sim-machine.toml"};
           args.insert(args.end(), extra.begin(), extra.end());
           return args;

@@ -20,7 +20,7 @@ const std::string kModel = std::string(LAMINA_EXAMPLES_DIR) + "/knob.stl";
 class LaminadRecovery : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(LaminadRecovery, KilledWhileCuttingComesBackInterruptedAndResumesOnRequest) {
-  Cell cell({"--on-open", GetParam()}, 40);
+  Cell cell({"--on-open", GetParam()}, 40, kKillWatchdogMs);
   auto daemon = std::make_unique<Laminad>(cell.config(), cell.dir.file(""));
   std::string id;
   {
@@ -95,7 +95,7 @@ class LogTail {
 // twice (2 of 2 tries). Now the CNC's executed count places it; the campaign's oracle checks that
 // no contour is cut twice, none skipped, none left dry.
 TEST(LaminadRecoveryAtAContourEnd, KilledJustAfterAContourFinishedCutsEveryContourOnce) {
-  Cell cell({}, 40);
+  Cell cell({}, 40, kKillWatchdogMs);
   auto daemon = std::make_unique<Laminad>(cell.config(), cell.dir.file(""));
   RpcClient c = connect(cell.socket());
   const std::string id = start_cutting(c, cell, 0);
@@ -130,7 +130,7 @@ TEST(LaminadRecoveryAtAContourEnd, KilledJustAfterAContourFinishedCutsEveryConto
 }
 
 TEST(LaminadShutdown, SigtermWhileCuttingLeavesTheCellSafeAndTheJobInterrupted) {
-  Cell cell({}, 40);
+  Cell cell({}, 40, kKillWatchdogMs);
   Laminad daemon(cell.config(), cell.dir.file(""));
   std::string id;
   {
