@@ -157,23 +157,6 @@ Path negated(const Path& ring) {
   return out;  // a point reflection keeps the turning sense
 }
 
-Paths boolean(ClipperLib::ClipType op, const Paths& subject, const Paths& clip) {
-  ClipperLib::Clipper c;
-  c.AddPaths(subject, ClipperLib::ptSubject, true);
-  c.AddPaths(clip, ClipperLib::ptClip, true);
-  Paths out;
-  c.Execute(op, out, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
-  return out;
-}
-
-Paths offset_mitre(const Paths& paths, double delta_mm) {
-  ClipperLib::ClipperOffset off;  // MiterLimit 2: squared beyond, the square's edge at |delta|
-  off.AddPaths(paths, ClipperLib::jtMiter, ClipperLib::etClosedPolygon);
-  Paths out;
-  off.Execute(out, delta_mm * kClipperUnitsPerMm);
-  return out;
-}
-
 Paths minkowski_sum(const Path& a, const Path& b) {
   if (a.empty() || b.empty()) return {};
   if (is_convex(a) && is_convex(b)) {

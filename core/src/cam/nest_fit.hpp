@@ -63,11 +63,7 @@ ClipperLib::Paths inner_fit_general(const ClipperLib::Paths& room, const Clipper
 ClipperLib::Path translated(const ClipperLib::Path& ring, ClipperLib::IntPoint by);
 ClipperLib::Path negated(const ClipperLib::Path& ring);  // −C, still counter-clockwise
 
-ClipperLib::Paths boolean(ClipperLib::ClipType op, const ClipperLib::Paths& subject, const ClipperLib::Paths& clip);
-
-// Offset with mitred joins (squared beyond Clipper's limit 2): every point the offset moves the
-// boundary past is at least |delta| away, i.e. a superset of the true (round) growth and, for a
-// negative delta, a subset of the true erosion.
-ClipperLib::Paths offset_mitre(const ClipperLib::Paths& paths, double delta_mm);
+using geometry_detail::boolean;       // clipper_bridge.hpp
+using geometry_detail::offset_mitre;  // clipper_bridge.hpp
 
 }  // namespace lamina::cam_detail

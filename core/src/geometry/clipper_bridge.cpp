@@ -58,4 +58,21 @@ double area_mm2(const ClipperLib::Paths& paths) {
   return sum / (kClipperUnitsPerMm * kClipperUnitsPerMm);
 }
 
+ClipperLib::Paths boolean(ClipperLib::ClipType op, const ClipperLib::Paths& subject, const ClipperLib::Paths& clip) {
+  ClipperLib::Clipper c;
+  c.AddPaths(subject, ClipperLib::ptSubject, true);
+  c.AddPaths(clip, ClipperLib::ptClip, true);
+  ClipperLib::Paths out;
+  c.Execute(op, out, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
+  return out;
+}
+
+ClipperLib::Paths offset_mitre(const ClipperLib::Paths& paths, double delta_mm) {
+  ClipperLib::ClipperOffset off;  // MiterLimit 2: squared beyond, the square's edge at |delta|
+  off.AddPaths(paths, ClipperLib::jtMiter, ClipperLib::etClosedPolygon);
+  ClipperLib::Paths out;
+  off.Execute(out, delta_mm * kClipperUnitsPerMm);
+  return out;
+}
+
 }  // namespace lamina::geometry_detail

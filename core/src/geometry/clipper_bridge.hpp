@@ -19,4 +19,12 @@ std::vector<Polygon2> from_clipper(const ClipperLib::Paths& paths);
 // Net signed area of paths in mm² (holes count negative).
 double area_mm2(const ClipperLib::Paths& paths);
 
+// A boolean of two regions read with the non-zero rule (outer rings CCW, holes CW).
+ClipperLib::Paths boolean(ClipperLib::ClipType op, const ClipperLib::Paths& subject, const ClipperLib::Paths& clip);
+
+// Offset with mitred joins (squared beyond Clipper's limit 2): every point the offset moves the
+// boundary past is at least |delta| away, i.e. a superset of the true (round) growth and, for a
+// negative delta, a subset of the true erosion.
+ClipperLib::Paths offset_mitre(const ClipperLib::Paths& paths, double delta_mm);
+
 }  // namespace lamina::geometry_detail

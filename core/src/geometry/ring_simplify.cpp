@@ -54,11 +54,10 @@ double turn_at(const Path& ring, std::size_t i) {
   return std::abs(std::atan2(ax * by - ay * bx, ax * bx + ay * by));
 }
 
-}  // namespace
-
-namespace {
-
-// The corners Douglas–Peucker keeps (douglas_peucker below).
+// The corners Douglas–Peucker keeps on a closed ring: every dropped corner lies within
+// `tol_units` of the chord that replaces it. Corners where the ring turns by more than
+// keep_turn_rad are kept (with fewer than two such, corner 0 or the sharp one and the corner
+// farthest from it).
 std::vector<bool> corners_kept(const Path& ring, double tol_units, double keep_turn_rad) {
   const std::size_t n = ring.size();
   std::vector<bool> keep(n, false);
@@ -99,15 +98,6 @@ SimplifiedRing kept_ring(const Path& ring, const std::vector<bool>& keep) {
   return out;
 }
 
-}  // namespace
-
-Path douglas_peucker(const Path& ring, double tol_units, double keep_turn_rad) {
-  if (ring.size() < 3) return ring;
-  return kept_ring(ring, corners_kept(ring, tol_units, keep_turn_rad)).ring;
-}
-
-namespace {
-
 // A simple ring (Clipper finds no crossing to split) with the same area as `ring`, to the
 // doubles' rounding of the areas in nm² (a ring of R 80 mm is 2·10¹⁶ nm², whose step is 4).
 bool is_simple(const Path& ring) {
@@ -118,36 +108,20 @@ bool is_simple(const Path& ring) {
   return std::abs(ClipperLib::Area(parts.front()) - area) <= std::max(1.0, 1e-12 * std::abs(area));
 }
 
-Paths offset_mitred(const Path& ring, double by_mm) {
-  ClipperLib::ClipperOffset off;  // MiterLimit 2: squared beyond, the square's edge at |by|
-  off.AddPath(ring, ClipperLib::jtMiter, ClipperLib::etClosedPolygon);
-  Paths out;
-  off.Execute(out, by_mm * kClipperUnitsPerMm);
-  return out;
-}
-
-double difference_area(const Path& a, const Path& b) {
-  ClipperLib::Clipper c;
-  c.AddPath(a, ClipperLib::ptSubject, true);
-  c.AddPath(b, ClipperLib::ptClip, true);
-  Paths out;
-  c.Execute(ClipperLib::ctDifference, out, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
-  return area_mm2(out);
-}
-
 }  // namespace
 
 SimplifiedRing simplified_beside_marked(const Path& ring, double by_mm, double keep_turn_rad) {
   const SimplifiedRing unchanged{ring, std::vector<char>(ring.size(), 0)};
-  const Paths moved = offset_mitred(ring, by_mm);
+  const Paths moved = offset_mitre({ring}, by_mm);
   if (moved.size() != 1 || !ClipperLib::Orientation(moved.front())) return unchanged;
   const Path& around = moved.front();
   SimplifiedRing out = kept_ring(around, corners_kept(around, 0.5 * std::abs(by_mm) * kClipperUnitsPerMm, keep_turn_rad));
   const Path& r = out.ring;
   if (r.size() >= ring.size() || r.size() < 3 || !ClipperLib::Orientation(r) || !is_simple(r)) return unchanged;
   // Belt and braces: the side must hold (else keep the ring itself).
-  const double wrong_side = by_mm > 0.0 ? difference_area(ring, r) : difference_area(r, ring);
-  if (wrong_side != 0.0) return unchanged;
+  const Paths wrong_side = by_mm > 0.0 ? boolean(ClipperLib::ctDifference, {ring}, {r})
+                                       : boolean(ClipperLib::ctDifference, {r}, {ring});
+  if (area_mm2(wrong_side) != 0.0) return unchanged;
   return out;
 }
 

@@ -9,11 +9,6 @@
 
 namespace lamina::geometry_detail {
 
-// Douglas–Peucker on a closed ring: every dropped corner lies within `tol_units` of the chord
-// that replaces it. Corners where the ring turns by more than keep_turn_rad are kept (with fewer
-// than two such, corner 0 or the sharp one and the corner farthest from it).
-ClipperLib::Path douglas_peucker(const ClipperLib::Path& ring, double tol_units, double keep_turn_rad = std::numbers::pi);
-
 // A simple counter-clockwise ring `by_mm` beside a counter-clockwise ring, outside it when
 // by_mm > 0 and inside when < 0: the ring offset by by_mm (mitred), then chords within |by| / 2,
 // so every point of the result stands between |by| / 2 and 2 |by| off the ring, on that side.

@@ -6,6 +6,7 @@
 #include "lamina/core/mesh_io.hpp"
 
 #include "bevel_checks.hpp"
+#include "mesh_checks.hpp"
 #include "revolve.hpp"
 
 #include <gtest/gtest.h>
@@ -20,15 +21,15 @@ namespace {
 using test_shapes::revolve;
 
 Mesh built_usable(const TriangleSoup& soup) {
-  auto m = build_mesh(soup, MeshParams{});
-  EXPECT_TRUE(m.has_value());
-  EXPECT_TRUE(m->usable());
-  return std::move(*m);
+  Mesh m = mesh_test::build_checked(soup);
+  EXPECT_TRUE(m.usable());
+  return m;
 }
 
 BevelPlan planned_with(const Mesh& mesh, const std::vector<LayerSpan>& layers, const BevelParams& p) {
   auto r = plan_bevels(mesh, layers, p);
   EXPECT_TRUE(r.has_value()) << (r ? "" : r.error().message);
+  if (!r) return {};
   return std::move(*r);
 }
 
@@ -49,6 +50,7 @@ TEST(BevelOutline, AFineConeGetsStationsAStationSpacingApartOffItsMaterial) {
   every_corner.outline_simplify_mm = 0.0;
   const BevelPlan fewer = planned_with(mesh, layer, simplified), all = planned_with(mesh, layer, every_corner);
   ASSERT_EQ(fewer.layers.size(), 1u);
+  ASSERT_EQ(all.layers.size(), 1u);
   EXPECT_TRUE(fewer.layers[0].outline_simplified);
   EXPECT_FALSE(all.layers[0].outline_simplified);
   EXPECT_GE(station_count(all), static_cast<std::size_t>(kCorners));
@@ -78,6 +80,8 @@ TEST(BevelOutline, ACoarseModelKeepsEveryCorner) {
   BevelParams every_corner;
   every_corner.outline_simplify_mm = 0.0;
   const BevelPlan a = planned_with(mesh, layer, BevelParams{}), b = planned_with(mesh, layer, every_corner);
+  ASSERT_EQ(a.layers.size(), 1u);
+  ASSERT_EQ(b.layers.size(), 1u);
   EXPECT_FALSE(a.layers[0].outline_simplified);
   EXPECT_EQ(station_count(a), station_count(b));
   EXPECT_EQ(a.layers[0].max_deviation_mm, b.layers[0].max_deviation_mm);
@@ -100,6 +104,7 @@ TEST(BevelOutline, ALayerThatJustMissesTheToleranceIsCutFromEveryCorner) {
   EXPECT_TRUE(cut.layers[1].within_tolerance) << cut.layers[1].max_deviation_mm;
   p.outline_simplify_mm = 0.0;
   const BevelPlan whole = planned_with(*mesh, {{z0, 1.0, 0.0, true}, {z0 + 1.0, 1.0, 0.0, true}}, p);
+  ASSERT_EQ(whole.layers.size(), 2u);
   EXPECT_LE(cut.layers[1].max_deviation_mm, whole.layers[1].max_deviation_mm + 1e-9);
 }
 
