@@ -4,6 +4,7 @@
 #include "lamina/core/stack_mesh.hpp"
 
 #include <fmt/format.h>
+#include <tbb/task_group.h>
 
 #include <algorithm>
 #include <chrono>
@@ -100,6 +101,14 @@ struct Run {
   std::shared_ptr<const ModelDistanceIndex> model_index;  // model_index(): built on first use
 };
 
+// What the plan alone decides, without the rack: its deviation(s) and its stack as STL.
+struct PlanMeasures {
+  std::expected<std::vector<StrategyDeviation>, PlanJobError> deviations;
+  double deviation_s = 0.0;
+  std::string stack_stl;
+  double write_s = 0.0;
+};
+
 // The model's triangle tree, built on first use and shared by the layering and the deviation.
 std::shared_ptr<const ModelDistanceIndex> model_index(Run& run) {
   if (!run.model_index) run.model_index = std::make_shared<const ModelDistanceIndex>(run.mesh, true);
@@ -133,10 +142,83 @@ std::expected<void, PlanJobError> layers_and_bevels(Run& run, const LayeringPara
   return {};
 }
 
+std::string stl_header(const PlanJobRequest& q, const BevelPlan& plan) {
+  // Never "solid…": readers would take the file for ASCII STL.
+  std::string h = fmt::format("lamina stack: {} layers, {} cut, of {}", plan.layers.size(),
+                              bevel_strategy_name(q.settings.strategy),
+                              std::filesystem::path(q.model.file).filename().string());
+  if (h.size() > 80) h.resize(80);
+  return h;
+}
+
+// The chosen strategy's deviation and, when asked, the same layering cut the other two ways (the
+// chosen strategy's plan is reused, not recomputed), then the stack as STL. Reports no progress:
+// it runs beside the nesting, whose thread reports (measures_beside_cam).
+PlanMeasures measure_plan(Run& run) {
+  constexpr BevelStrategy kAll[] = {BevelStrategy::vertical, BevelStrategy::sloped, BevelStrategy::curved};
+  const PlanSettings& settings = run.q.settings;
+  std::vector<BevelStrategy> measured{settings.strategy};
+  if (settings.compare_strategies) measured.assign(std::begin(kAll), std::end(kAll));
+  PlanMeasures m;
+  auto t0 = Clock::now();
+  std::vector<StrategyDeviation> deviations;
+  for (const BevelStrategy s : measured) {
+    std::optional<BevelPlan> other;
+    if (s != settings.strategy) {
+      BevelParams geometry_only = bevel_params(settings, s);
+      geometry_only.measure_surface_distance = false;  // its stack is measured as a whole below
+      auto p = plan_bevels(run.mesh, run.r.layering.layers, geometry_only);
+      if (!p) {
+        m.deviations = failed(PlanPhase::measuring_deviation, p.error());
+        return m;
+      }
+      other = std::move(*p);
+    }
+    const Mesh& reference = run.q.deviation_reference ? *run.q.deviation_reference : run.mesh;
+    DeviationParams dp = deviation_params(settings);
+    if (&reference == &run.mesh) dp.model_index = run.model_index;  // the layering's (layers_and_bevels)
+    auto d = measure_deviation(reference, other ? *other : run.r.plan, dp);
+    if (!d) {
+      m.deviations = failed(PlanPhase::measuring_deviation, d.error());
+      return m;
+    }
+    deviations.push_back({s, *d});
+  }
+  m.deviations = std::move(deviations);
+  m.deviation_s = seconds_since(t0);
+  // Not needed past the deviation (the stack is written without it; 1M sphere: 53 MB); a round
+  // the rack sends back builds it again.
+  run.model_index.reset();
+  t0 = Clock::now();
+  m.stack_stl = binary_stl_bytes(stack_mesh(run.r.plan), stl_header(run.q, run.r.plan));
+  m.write_s = seconds_since(t0);
+  return m;
+}
+
+// The plan's measures taken, their progress said in phase order (they ran beside the nesting
+// when there were sheets to cut, and are done or nearly done by now).
+std::expected<void, PlanJobError> adopt_measures(Run& run, PlanMeasures m) {
+  run.progress.start(PlanPhase::measuring_deviation);
+  if (!m.deviations) return std::unexpected(m.deviations.error());
+  run.r.deviations = std::move(*m.deviations);
+  const int n = static_cast<int>(run.r.deviations.size());
+  for (int i = 1; i <= n; ++i) run.progress.step(PlanPhase::measuring_deviation, i, n);
+  run.timing.deviation = m.deviation_s;
+  run.progress.start(PlanPhase::writing_stack);
+  run.r.stack_stl = std::move(m.stack_stl);
+  run.timing.write = m.write_s;
+  return {};
+}
+
 // Layers, bevels and (with cut settings) parts, nesting and programs, fitted to the rack (issue
 // 17, item 5): a layer is only cut from sheets its outlines fit, and when the nesting runs out of
 // a thickness, that thickness is limited to the layers its sheets held and the stack is laid out
 // again, so the plan fits the rack or one error says which thickness runs out.
+//
+// The plan's measures (deviation, stack STL) need the plan alone: they run beside the nesting
+// and programs on the thread pool (the 1M sphere's 2.6 MB program is one thread's work, and kept
+// a core idle for 0.2 s). A round the rack sends back was measured for nothing; it is rare, and
+// the measures of the plan that fits are the ones kept.
 std::expected<void, PlanJobError> plan_on_rack(Run& run) {
   const PlanSettings& settings = run.q.settings;
   const std::optional<CamSettings>& cam = run.q.cam;
@@ -149,13 +231,21 @@ std::expected<void, PlanJobError> plan_on_rack(Run& run) {
   const std::string title = std::filesystem::path(run.q.model.file).filename().string();
   for (int round = 0;; ++round) {
     if (auto ok = layers_and_bevels(run, params, round == 0); !ok) return ok;
-    if (!cam) break;
+    if (!cam) {
+      if (auto ok = adopt_measures(run, measure_plan(run)); !ok) return ok;
+      break;
+    }
     if (round == 0) run.progress.start(PlanPhase::nesting_and_programs);
     std::vector<SheetShortage> shortages;
+    PlanMeasures measures;
+    tbb::task_group beside;
+    beside.run([&] { measures = measure_plan(run); });
     auto c = plan_cam(run.r.plan, *stock, *cam, title, &shortages,
                       [&](int done, int total) { run.progress.step(PlanPhase::nesting_and_programs, done, total); });
+    beside.wait();
     if (c) {
       run.r.cam = std::move(*c);
+      if (auto ok = adopt_measures(run, std::move(measures)); !ok) return ok;
       break;
     }
     if (c.error().code != ErrorCode::stock_exhausted || round + 1 >= kMaxRackRounds ||
@@ -169,46 +259,6 @@ std::expected<void, PlanJobError> plan_on_rack(Run& run) {
   w.insert(w.end(), rack_warnings.begin(), rack_warnings.end());
   if (run.r.cam) w.insert(w.end(), run.r.cam->warnings.begin(), run.r.cam->warnings.end());
   return {};
-}
-
-// The chosen strategy's deviation and, when asked, the same layering cut the other two ways; the
-// chosen strategy's plan is reused, not recomputed.
-std::expected<void, PlanJobError> measure_strategies(Run& run) {
-  constexpr BevelStrategy kAll[] = {BevelStrategy::vertical, BevelStrategy::sloped, BevelStrategy::curved};
-  const PlanSettings& settings = run.q.settings;
-  std::vector<BevelStrategy> measured{settings.strategy};
-  if (settings.compare_strategies) measured.assign(std::begin(kAll), std::end(kAll));
-  run.progress.start(PlanPhase::measuring_deviation);
-  const auto t0 = Clock::now();
-  for (const BevelStrategy s : measured) {
-    std::optional<BevelPlan> other;
-    if (s != settings.strategy) {
-      BevelParams geometry_only = bevel_params(settings, s);
-      geometry_only.measure_surface_distance = false;  // its stack is measured as a whole below
-      auto p = plan_bevels(run.mesh, run.r.layering.layers, geometry_only);
-      if (!p) return failed(PlanPhase::measuring_deviation, p.error());
-      other = std::move(*p);
-    }
-    const Mesh& reference = run.q.deviation_reference ? *run.q.deviation_reference : run.mesh;
-    DeviationParams dp = deviation_params(settings);
-    if (&reference == &run.mesh) dp.model_index = model_index(run);
-    auto d = measure_deviation(reference, other ? *other : run.r.plan, dp);
-    if (!d) return failed(PlanPhase::measuring_deviation, d.error());
-    run.r.deviations.push_back({s, *d});
-    run.progress.step(PlanPhase::measuring_deviation, static_cast<int>(run.r.deviations.size()),
-                       static_cast<int>(measured.size()));
-  }
-  run.timing.deviation = seconds_since(t0);
-  return {};
-}
-
-std::string stl_header(const PlanJobRequest& q, const BevelPlan& plan) {
-  // Never "solid…": readers would take the file for ASCII STL.
-  std::string h = fmt::format("lamina stack: {} layers, {} cut, of {}", plan.layers.size(),
-                              bevel_strategy_name(q.settings.strategy),
-                              std::filesystem::path(q.model.file).filename().string());
-  if (h.size() > 80) h.resize(80);
-  return h;
 }
 
 }  // namespace
@@ -231,13 +281,6 @@ std::expected<PlanJobResult, PlanJobError> plan_job(const Mesh& mesh, const Plan
   if (auto ok = check_against_model(request.settings, mesh); !ok) return failed(PlanPhase::checking, ok.error());
   Run run{mesh, request, Progress(progress), {}, {}, request.warnings, {}};
   if (auto ok = plan_on_rack(run); !ok) return std::unexpected(ok.error());
-  if (auto ok = measure_strategies(run); !ok) return std::unexpected(ok.error());
-  run.model_index.reset();  // not needed past the deviation: the stack is written without it (1M sphere: 53 MB)
-
-  run.progress.start(PlanPhase::writing_stack);
-  const auto t0 = Clock::now();
-  run.r.stack_stl = binary_stl_bytes(stack_mesh(run.r.plan), stl_header(request, run.r.plan));
-  run.timing.write = seconds_since(t0);
 
   run.timing.read = request.model.read_s;
   run.timing.topology = request.model.topology_s;

@@ -4,12 +4,14 @@
 // reports that do not match the schema are refused naming the key.
 #include "lamina/core/plan_job.hpp"
 #include "lamina/core/plan_report.hpp"
+#include "lamina/core/stack_mesh.hpp"
 
 #include "mesh_soups.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -228,6 +230,27 @@ TEST(PlanJob, ProgressNamesEveryPhaseInOrderAndItsStepsGrow) {
   // Each part as the nesting places it (the Menger sponge nested for a minute with the bar still),
   // then each sheet's program.
   EXPECT_EQ(sheet_steps, static_cast<int>(r->cam->parts.size() + r->cam->sheets.size()));
+}
+
+// The plan's measures (deviation, stack) are taken beside the nesting. When the rack sends the
+// stack back (the nesting ran out of a thickness), the measures kept must be the final plan's,
+// not those of the stack it sent back.
+TEST(PlanJob, WhenTheRackSendsTheStackBackTheMeasuresAreTheFinalPlans) {
+  PlanJobRequest q = request(true);
+  // One Ø40 layer per 5 mm sheet (70 mm, less the margins), one such sheet: the ball's first
+  // stack takes several 5 mm layers, the nesting places one, and the stack is laid out again.
+  q.settings.stock.sheets = {{2.5, 300, 300, 40, "", ""}, {5.0, 70, 70, 1, "", ""}};
+  auto r = plan_job(ball(), q);
+  ASSERT_TRUE(r) << r.error().error.message;
+  const auto& w = r->report.warnings;
+  ASSERT_TRUE(std::any_of(w.begin(), w.end(), [](const std::string& s) { return s.find("the rack's 5 mm") != s.npos; }))
+      << "the rack must have sent the first stack back";
+  auto d = measure_deviation(ball(), r->plan, deviation_params(q.settings));
+  ASSERT_TRUE(d) << d.error().message;
+  ASSERT_EQ(r->deviations.size(), 1u);
+  EXPECT_EQ(r->deviations[0].deviation.volume_mm3, d->volume_mm3);
+  EXPECT_EQ(r->deviations[0].deviation.max_mm, d->max_mm);
+  EXPECT_EQ(r->stack_stl.size(), 84 + 50 * (stack_mesh(r->plan).corners.size() / 3));
 }
 
 TEST(PlanJob, AnErrorSaysInWhichPhase) {
