@@ -28,16 +28,6 @@ constexpr double kMinChordRate = 0.25;
 // Pieces of material outside the cuts with less area than this are rounding slivers.
 constexpr double kMinPieceArea = 1e-8;
 
-ClipperLib::Paths material_of(const Slice& slice) {
-  ClipperLib::Paths loops;
-  for (const Loop& l : slice.loops) loops.push_back(to_clipper(l.points));
-  ClipperLib::Clipper c;
-  c.AddPaths(loops, ClipperLib::ptSubject, true);
-  ClipperLib::Paths out;
-  c.Execute(ClipperLib::ctUnion, out, ClipperLib::pftPositive, ClipperLib::pftPositive);
-  return out;
-}
-
 struct Chord {
   int outline;
   std::size_t a, b;  // stations
@@ -230,7 +220,7 @@ GougeClearance clear_gouges(LayerPlan& layer, const std::vector<const Slice*>& s
   GougeClearance r;
   std::vector<ClipperLib::Paths> material;
   material.reserve(sub_slices.size());
-  for (const Slice* s : sub_slices) material.push_back(material_of(*s));
+  for (const Slice* s : sub_slices) material.push_back(geometry_detail::slice_material(*s));
 
   std::vector<std::vector<double>> moved(layer.outlines.size()), shift(layer.outlines.size());
   for (std::size_t o = 0; o < layer.outlines.size(); ++o) moved[o].assign(layer.outlines[o].stations.size(), 0.0);

@@ -86,29 +86,6 @@ struct SectionAreas {
   double xor_mm2 = 0.0, stack_mm2 = 0.0;
 };
 
-// The model's section as Clipper paths and its area. The slicer's loops do not cross (it unites
-// shells that overlap) and are oriented outer counter-clockwise, holes clockwise: their area is
-// the signed sum (taken of the same 1 nm paths the intersection reads), and Clipper takes them
-// as they are. Loops closed by the gap rule (an open mesh)
-// may cross: those sections are united first. (Every section was united before: a full Clipper
-// pass per section, a third of the 1M sphere's section time.)
-ClipperLib::Paths model_section(const Slice& slice, double& area_mm2) {
-  ClipperLib::Paths model;
-  for (const auto& loop : slice.loops) model.push_back(geometry_detail::to_clipper(loop.points));
-  const bool clean = slice.open_chains.empty() &&
-                     std::none_of(slice.loops.begin(), slice.loops.end(), [](const Loop& l) { return l.gap_closed; });
-  if (clean) {
-    area_mm2 = geometry_detail::area_mm2(model);
-    return model;
-  }
-  ClipperLib::Clipper c;
-  c.AddPaths(model, ClipperLib::ptSubject, true);
-  ClipperLib::Paths united;
-  c.Execute(ClipperLib::ctUnion, united, ClipperLib::pftPositive, ClipperLib::pftPositive);
-  area_mm2 = geometry_detail::area_mm2(united);
-  return united;
-}
-
 // One section: the model's (its slice) against the stack's (the layers cut there), as
 // |A xor B| = |A| + |B| − 2 |A ∩ B|: Clipper's XOR of two nearly equal sections returns thousands
 // of slivers and sorts out their nesting in quadratic time; the intersection is one clean polygon.
@@ -128,8 +105,8 @@ SectionAreas section_areas(const Slice& slice, const BevelPlan& plan, double z) 
   }
   SectionAreas r;
   r.stack_mm2 = geometry_detail::area_mm2(stack);
-  double model_area = 0.0;
-  const ClipperLib::Paths model = model_section(slice, model_area);
+  const ClipperLib::Paths model = geometry_detail::slice_material(slice);
+  const double model_area = geometry_detail::area_mm2(model);
   double common = 0.0;
   if (!model.empty() && !stack.empty()) {
     ClipperLib::Clipper c;

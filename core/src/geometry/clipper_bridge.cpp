@@ -1,5 +1,6 @@
 #include "geometry/clipper_bridge.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace lamina {
@@ -56,6 +57,20 @@ double area_mm2(const ClipperLib::Paths& paths) {
   double sum = 0.0;
   for (const auto& p : paths) sum += ClipperLib::Area(p);
   return sum / (kClipperUnitsPerMm * kClipperUnitsPerMm);
+}
+
+ClipperLib::Paths slice_material(const Slice& slice) {
+  ClipperLib::Paths loops;
+  loops.reserve(slice.loops.size());
+  for (const Loop& l : slice.loops) loops.push_back(to_clipper(l.points));
+  const bool clean = slice.open_chains.empty() &&
+                     std::none_of(slice.loops.begin(), slice.loops.end(), [](const Loop& l) { return l.gap_closed; });
+  if (clean) return loops;
+  ClipperLib::Clipper c;
+  c.AddPaths(loops, ClipperLib::ptSubject, true);
+  ClipperLib::Paths united;
+  c.Execute(ClipperLib::ctUnion, united, ClipperLib::pftPositive, ClipperLib::pftPositive);
+  return united;
 }
 
 ClipperLib::Paths boolean(ClipperLib::ClipType op, const ClipperLib::Paths& subject, const ClipperLib::Paths& clip) {

@@ -2,6 +2,7 @@
 // Private: between our polygons (double mm) and Clipper 6's integer paths. One scale for the
 // whole library: 1 unit = 1 nm, so ±4.6e9 m of range and far below any mesh's float precision.
 #include "lamina/core/polygon.hpp"
+#include "lamina/core/slice.hpp"
 
 #include <polyclipping/clipper.hpp>
 
@@ -18,6 +19,13 @@ std::vector<Polygon2> from_clipper(const ClipperLib::Paths& paths);
 
 // Net signed area of paths in mm² (holes count negative).
 double area_mm2(const ClipperLib::Paths& paths);
+
+// A slice's material as paths a boolean can read with the positive rule. The slicer's loops do
+// not cross (it unites shells that overlap) and are oriented outer counter-clockwise, holes
+// clockwise: they are taken as they are. Loops closed by the gap rule (an open mesh) may cross:
+// those slices are united first. (Uniting every slice was a full Clipper pass per section, a third
+// of the 1M sphere's deviation sections.)
+ClipperLib::Paths slice_material(const Slice& slice);
 
 // A boolean of two regions read with the non-zero rule (outer rings CCW, holes CW).
 ClipperLib::Paths boolean(ClipperLib::ClipType op, const ClipperLib::Paths& subject, const ClipperLib::Paths& clip);

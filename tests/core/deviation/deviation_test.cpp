@@ -6,6 +6,7 @@
 #include "mesh_soups.hpp"
 #include "shapes.hpp"
 
+#include "geometry/clipper_bridge.hpp"
 #include "lamina/core/model_index.hpp"
 
 #include <gtest/gtest.h>
@@ -123,6 +124,31 @@ TEST(LayerSection, InwardCornersDropTheirSwallowtails) {
 
 // ---------------------------------------------------------------------------------------------
 // measure_deviation: volume
+
+// A slice's material for the booleans (the deviation's sections, the gouge check): the slicer's
+// loops as they are, unless the gap rule closed some, which may cross and are united first.
+Loop square_loop(double x0, double y0, double side, bool gap_closed) {
+  Loop l;
+  l.points = {{x0, y0}, {x0 + side, y0}, {x0 + side, y0 + side}, {x0, y0 + side}};
+  l.facets.assign(4, -1);
+  l.area_mm2 = side * side;
+  l.gap_closed = gap_closed;
+  return l;
+}
+
+TEST(SliceMaterial, TheSlicersLoopsAreTakenAsTheyAreAndGapClosedOnesUnited) {
+  Slice clean;
+  clean.loops = {square_loop(0, 0, 10, false), square_loop(20, 0, 10, false)};
+  const ClipperLib::Paths as_is = geometry_detail::slice_material(clean);
+  ASSERT_EQ(as_is.size(), 2u);
+  EXPECT_EQ(as_is[0], geometry_detail::to_clipper(clean.loops[0].points)) << "not rewritten";
+  EXPECT_NEAR(geometry_detail::area_mm2(as_is), 200.0, 1e-9);
+
+  // Two chains of an open mesh closed into squares that overlap by 5 x 10: their union, 150 mm².
+  Slice open;
+  open.loops = {square_loop(0, 0, 10, true), square_loop(5, 0, 10, true)};
+  EXPECT_NEAR(geometry_detail::area_mm2(geometry_detail::slice_material(open)), 150.0, 1e-9);
+}
 
 TEST(Deviation, StationsOnTheMeshVerticesLeaveOnlyRounding) {
   const double r = 20.0, h = 10.0;
