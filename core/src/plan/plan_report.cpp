@@ -60,6 +60,7 @@ ReportLayer layer_report(const LayerPlan& l, const LayerSpan* span) {
   r.stations = stations;
   r.shapes = {shape(ProfileShape::convex), shape(ProfileShape::concave), shape(ProfileShape::straight),
               shape(ProfileShape::mixed), shape(ProfileShape::empty)};
+  r.outline_simplified = l.outline_simplified;
   return r;
 }
 

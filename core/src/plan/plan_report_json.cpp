@@ -101,7 +101,9 @@ struct Fields<ReportLayer> {
       Field{"estimated_deviation_mm", &S::estimated_deviation_mm},
       Field{"outlines", &S::outlines},
       Field{"stations", &S::stations},
-      Field{"shapes", &S::shapes}};
+      Field{"shapes", &S::shapes},
+      Field{"outline_simplified", &S::outline_simplified}};
+  static constexpr bool omit_empty(std::string_view key) { return key == "outline_simplified"; }
 };
 template <>
 struct Fields<ReportStack> {

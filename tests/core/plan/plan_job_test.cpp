@@ -168,6 +168,31 @@ TEST(PlanJob, AReportWithoutHeadOrSlotsStillReads) {
   EXPECT_FALSE(back->sheets->back().slot);
 }
 
+// Which layers were cut from an outline simplified off the material (issue 22): said per layer
+// in report.json; a report written before the key reads without it.
+TEST(PlanJob, TheReportSaysWhichLayersStandOnASimplifiedOutline) {
+  static const Mesh fine = [] {
+    auto m = build_mesh(mesh_test::uv_sphere(20.0, 720, 32, Eigen::Vector3d(0, 0, 20)), MeshParams{});
+    return std::move(*m);
+  }();
+  auto r = plan_job(fine, request(false));
+  ASSERT_TRUE(r) << r.error().error.message;
+  ASSERT_EQ(r->report.layers.size(), r->plan.layers.size());
+  int simplified = 0;
+  for (std::size_t i = 0; i < r->plan.layers.size(); ++i) {
+    ASSERT_TRUE(r->report.layers[i].outline_simplified.has_value()) << "layer " << i;
+    EXPECT_EQ(*r->report.layers[i].outline_simplified, r->plan.layers[i].outline_simplified) << "layer " << i;
+    simplified += r->plan.layers[i].outline_simplified ? 1 : 0;
+  }
+  EXPECT_GT(simplified, 0) << "a 720-facet ring is simplified";
+  nlohmann::json j = nlohmann::json::parse(plan_report_json(r->report));
+  EXPECT_TRUE(j["layers"][0].contains("outline_simplified"));
+  for (auto& l : j["layers"]) l.erase("outline_simplified");
+  auto back = parse_plan_report(j.dump());
+  ASSERT_TRUE(back) << back.error().message;
+  EXPECT_FALSE(back->layers.front().outline_simplified);
+}
+
 TEST(PlanJob, WithoutProgramsTheReportHasNoSheetsAndReadsBack) {
   auto r = plan_job(ball(), request(false));
   ASSERT_TRUE(r) << r.error().error.message;

@@ -86,6 +86,9 @@ struct ReportLayer {
   std::optional<double> estimated_deviation_mm;
   std::int64_t outlines = 0, stations = 0;
   ReportShapes shapes;
+  // Its stations stand on an outline simplified off the material (docs/bevels.md); absent in
+  // reports written before the field was.
+  std::optional<bool> outline_simplified;
 };
 
 struct ReportStack {
