@@ -61,12 +61,17 @@ ClipperLib::Paths facet_shadows(const Mesh& mesh, const std::vector<std::uint32_
     const Eigen::Vector2d p = v.head<2>();
     return sections[lo].contains(p) || sections[hi].contains(p);
   };
-  // A vertex is a corner of about six facets: its answer is kept (0 unknown, 1 outside, 2 inside).
-  std::vector<std::uint8_t> vertex_inside(mesh.vertices.size(), 0);
-  auto vertex_inside_neighbour = [&](std::int32_t v) {
-    std::uint8_t& known = vertex_inside[static_cast<std::size_t>(v)];
-    if (known == 0) known = inside_neighbour(mesh.vertices[static_cast<std::size_t>(v)]) ? 2 : 1;
+  // A vertex is a corner of about six facets, an edge's midpoint is on two: their answers are
+  // kept (0 unknown, 1 outside, 2 inside).
+  std::vector<std::uint8_t> vertex_inside(mesh.vertices.size(), 0), midpoint_inside;
+  const bool edges_known = mesh.face_edges.size() == mesh.faces.size();
+  if (edges_known) midpoint_inside.assign(mesh.edges.size(), 0);
+  auto kept = [&](std::uint8_t& known, const Eigen::Vector3d& p) {
+    if (known == 0) known = inside_neighbour(p) ? 2 : 1;
     return known == 2;
+  };
+  auto vertex_inside_neighbour = [&](std::int32_t v) {
+    return kept(vertex_inside[static_cast<std::size_t>(v)], mesh.vertices[static_cast<std::size_t>(v)]);
   };
   for (const std::uint32_t f : slab_facets) {  // the facets whose z range meets [zb, zt]
     if (std::abs(mesh.normals[f].z()) < 0.02) continue;  // a wall: its shadow is a line
@@ -98,7 +103,11 @@ ClipperLib::Paths facet_shadows(const Mesh& mesh, const std::vector<std::uint32_
     for (std::size_t i = 0; i < poly.size() && all_inside; ++i) {
       centre += poly[i];
       const bool corner = unclipped ? vertex_inside_neighbour(tri[i]) : inside_neighbour(poly[i]);
-      all_inside = corner && inside_neighbour(0.5 * (poly[i] + poly[(i + 1) % poly.size()]));
+      // The same midpoint, the same point, from both facets of an edge (a + b = b + a).
+      const Eigen::Vector3d mid = 0.5 * (poly[i] + poly[(i + 1) % poly.size()]);
+      all_inside = corner && (unclipped && edges_known
+                                  ? kept(midpoint_inside[static_cast<std::size_t>(mesh.face_edges[f][i])], mid)
+                                  : inside_neighbour(mid));
     }
     all_inside = all_inside && inside_neighbour(centre / static_cast<double>(poly.size()));
     if (all_inside) continue;
