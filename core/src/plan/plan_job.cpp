@@ -153,7 +153,7 @@ std::string stl_header(const PlanJobRequest& q, const BevelPlan& plan) {
 
 // The chosen strategy's deviation and, when asked, the same layering cut the other two ways (the
 // chosen strategy's plan is reused, not recomputed), then the stack as STL. Reports no progress:
-// it runs beside the nesting, whose thread reports (measures_beside_cam).
+// it runs beside the nesting, whose thread reports (plan_on_rack, adopt_measures).
 PlanMeasures measure_plan(Run& run) {
   constexpr BevelStrategy kAll[] = {BevelStrategy::vertical, BevelStrategy::sloped, BevelStrategy::curved};
   const PlanSettings& settings = run.q.settings;
